@@ -1,0 +1,225 @@
+//! Area lights (DESIGN section 3): the [`AreaLight`] trait and its shapes, rectangle, disk,
+//! polygon (convex or concave, triangulated with `spade`), sphere (omni-directional) and the
+//! point light as the zero-size limit, each with constant or textured radiance.
+//!
+//! Every light maps the unit square area-uniformly onto its surface ([`AreaLight::sample`]), so
+//! a stratified pattern in the unit square stays stratified on the light (DCS section 5).
+//!
+//! Conventions shared by every technique and the reference:
+//! * Planar lights emit from the side their normal points to; the visibility coefficient
+//!   `V(p)` ignores the emission side (it is the visible fraction of the light's area), the
+//!   direct illumination uses the clamped cosine at the light.
+//! * A sphere light is an emitting shell that does not occlude itself (DCS section 7.1
+//!   parametrises omni-directional lights in 2D): `V(p)` is the fraction of its whole surface
+//!   visible through the scene, while only the half facing `p` contributes to direct illumination.
+
+mod polygon;
+mod radiance;
+mod shapes;
+
+pub use polygon::PolygonLight;
+pub use radiance::{Radiance, TexturedRadiance};
+pub use shapes::{DiskLight, PointLight, RectLight, SphereLight};
+
+use std::fmt::Debug;
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3};
+use serde::Serialize;
+use thiserror::Error;
+
+use crate::geometry::Aabb;
+
+/// Why a light could not be built.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum LightError {
+    /// A position, direction or size is NaN or infinite.
+    #[error("light parameter `{what}` is not finite")]
+    NonFinite {
+        /// Which parameter.
+        what: &'static str,
+    },
+    /// A size is zero or negative.
+    #[error("light parameter `{what}` must be positive, got {value}")]
+    NonPositive {
+        /// Which parameter.
+        what: &'static str,
+        /// The offending value.
+        value: f32,
+    },
+    /// Two axes of a rectangle are parallel or a normal has zero length.
+    #[error("light frame is degenerate: {0}")]
+    DegenerateFrame(&'static str),
+    /// A polygon outline is not a simple polygon with at least three vertices.
+    #[error("polygon light outline is invalid: {0}")]
+    InvalidPolygon(String),
+    /// A radiance is negative or not finite.
+    #[error("light radiance must be finite and non-negative, got {0:?}")]
+    InvalidRadiance([f32; 3]),
+    /// A radiance texture is empty or holds invalid texels.
+    #[error("light texture is invalid: {0}")]
+    InvalidTexture(String),
+}
+
+/// One point on a light, as the samplers produce it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightSample {
+    /// Position on the light surface (world space).
+    pub position: Vec3,
+    /// Unit emission normal at the sample.
+    pub normal: Vec3,
+    /// The light's own parametrisation of the sample in `[0, 1]^2` (texture lookup).
+    pub uv: Vec2,
+    /// Emitted radiance at the sample (RGB).
+    pub radiance: Vec3,
+}
+
+/// A description of a light's shape, for techniques that need the exact geometry (outlines for
+/// back-projection, wedges, influence regions).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LightGeometry<'a> {
+    /// A rectangle: centre, two half-extent axes (orthogonal), unit normal `= normalize(u x v)`.
+    Rectangle {
+        /// Centre.
+        center: Vec3,
+        /// Half-extent along the first axis.
+        half_u: Vec3,
+        /// Half-extent along the second axis.
+        half_v: Vec3,
+        /// Unit normal.
+        normal: Vec3,
+    },
+    /// A disk: centre, unit normal, radius.
+    Disk {
+        /// Centre.
+        center: Vec3,
+        /// Unit normal.
+        normal: Vec3,
+        /// Radius.
+        radius: f32,
+    },
+    /// A planar simple polygon, counter-clockwise around `normal`.
+    Polygon {
+        /// Outline in world space.
+        outline: &'a [Vec3],
+        /// Unit normal.
+        normal: Vec3,
+    },
+    /// A sphere (omni-directional light).
+    Sphere {
+        /// Centre.
+        center: Vec3,
+        /// Radius.
+        radius: f32,
+    },
+    /// A point light (zero-size limit: hard shadows).
+    Point {
+        /// Position.
+        position: Vec3,
+    },
+}
+
+/// Which family a light belongs to, for capability checks.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, PartialOrd, Ord)]
+pub enum LightKind {
+    /// [`RectLight`].
+    Rectangle,
+    /// [`DiskLight`].
+    Disk,
+    /// [`PolygonLight`].
+    Polygon,
+    /// [`SphereLight`].
+    Sphere,
+    /// [`PointLight`].
+    Point,
+}
+
+impl LightGeometry<'_> {
+    /// The family of this shape.
+    pub fn kind(&self) -> LightKind {
+        match self {
+            Self::Rectangle { .. } => LightKind::Rectangle,
+            Self::Disk { .. } => LightKind::Disk,
+            Self::Polygon { .. } => LightKind::Polygon,
+            Self::Sphere { .. } => LightKind::Sphere,
+            Self::Point { .. } => LightKind::Point,
+        }
+    }
+
+    /// The plane normal of planar lights, `None` for spheres and points.
+    pub fn plane_normal(&self) -> Option<Vec3> {
+        match *self {
+            Self::Rectangle { normal, .. }
+            | Self::Disk { normal, .. }
+            | Self::Polygon { normal, .. } => Some(normal),
+            Self::Sphere { .. } | Self::Point { .. } => None,
+        }
+    }
+}
+
+/// An emitting surface.
+///
+/// Contract: [`AreaLight::sample`] maps `u` in `[0, 1)^2` to a point on the surface with a
+/// density proportional to area (uniform), continuously enough that a stratified `u` pattern
+/// stays stratified; it is deterministic and never returns a non-finite value. `area()` is 0
+/// only for the point light.
+pub trait AreaLight: Send + Sync + Debug {
+    /// The exact shape.
+    fn geometry(&self) -> LightGeometry<'_>;
+    /// Surface area (0 for a point light).
+    fn area(&self) -> f32;
+    /// A central point (the point standard shadow maps and DCS's integration constant use).
+    fn center(&self) -> Vec3;
+    /// Bounds of the surface.
+    fn bounds(&self) -> Aabb;
+    /// Maps `u` in `[0, 1)^2` area-uniformly onto the light (position, normal, uv only).
+    fn point_at(&self, u: Vec2) -> (Vec3, Vec3, Vec2);
+    /// The emitted radiance.
+    fn radiance(&self) -> &Radiance;
+
+    /// The full light sample at `u`, radiance included.
+    fn sample(&self, u: Vec2) -> LightSample {
+        let (position, normal, uv) = self.point_at(u);
+        LightSample {
+            position,
+            normal,
+            uv,
+            radiance: self.radiance().at(uv),
+        }
+    }
+    /// Family of the light.
+    fn kind(&self) -> LightKind {
+        self.geometry().kind()
+    }
+    /// True when the radiance varies over the light.
+    fn is_textured(&self) -> bool {
+        matches!(self.radiance(), Radiance::Textured(_))
+    }
+}
+
+/// A shared, immutable light as scenes and techniques pass it around.
+pub type Light = Arc<dyn AreaLight>;
+
+pub(crate) fn check_finite3(v: Vec3, what: &'static str) -> Result<(), LightError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(LightError::NonFinite { what })
+    }
+}
+
+pub(crate) fn check_positive(value: f32, what: &'static str) -> Result<(), LightError> {
+    if !value.is_finite() {
+        Err(LightError::NonFinite { what })
+    } else if value <= 0.0 {
+        Err(LightError::NonPositive { what, value })
+    } else {
+        Ok(())
+    }
+}
+
+pub(crate) fn unit(v: Vec3, what: &'static str) -> Result<Vec3, LightError> {
+    check_finite3(v, what)?;
+    v.try_normalize()
+        .ok_or(LightError::DegenerateFrame("zero-length direction"))
+}

@@ -1,0 +1,165 @@
+//! Light radiance: constant, or an RGB image over the light's `[0, 1]^2` parametrisation
+//! (textured lights, DCS eq. 2).
+
+use std::sync::Arc;
+
+use glam::{Affine2, Vec2, Vec3};
+
+use super::LightError;
+
+/// Radiance of a light.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Radiance {
+    /// The same RGB radiance everywhere.
+    Constant(Vec3),
+    /// An RGB image over the light's uv.
+    Textured(TexturedRadiance),
+}
+
+impl Radiance {
+    /// A constant radiance.
+    ///
+    /// # Errors
+    /// [`LightError::InvalidRadiance`] for negative or non-finite components.
+    pub fn constant(rgb: Vec3) -> Result<Self, LightError> {
+        if rgb.is_finite() && rgb.min_element() >= 0.0 {
+            Ok(Self::Constant(rgb))
+        } else {
+            Err(LightError::InvalidRadiance(rgb.to_array()))
+        }
+    }
+
+    /// Radiance at light uv `uv`.
+    pub fn at(&self, uv: Vec2) -> Vec3 {
+        match self {
+            Self::Constant(c) => *c,
+            Self::Textured(t) => t.at(uv),
+        }
+    }
+
+    /// Mean radiance over the light (for a texture: the mean over its uv square).
+    pub fn mean(&self) -> Vec3 {
+        match self {
+            Self::Constant(c) => *c,
+            Self::Textured(t) => t.mean,
+        }
+    }
+}
+
+/// An RGB image mapped onto a light.
+///
+/// Texture coordinates are `texture_from_light * uv`; the image repeats outside `[0, 1]^2`
+/// (the glTF default wrap) and is filtered bilinearly. Texels are linear radiance multiplied by
+/// `scale`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TexturedRadiance {
+    width: u32,
+    height: u32,
+    texels: Arc<[Vec3]>,
+    scale: Vec3,
+    texture_from_light: Affine2,
+    mean: Vec3,
+}
+
+impl TexturedRadiance {
+    /// A texture of `width x height` linear RGB texels (row 0 at `v = 0`), scaled by `scale`.
+    ///
+    /// # Errors
+    /// [`LightError::InvalidTexture`] when the image is empty, its size does not match, or a
+    /// texel or the scale is negative or non-finite.
+    pub fn new(
+        width: u32,
+        height: u32,
+        texels: Vec<Vec3>,
+        scale: Vec3,
+        texture_from_light: Affine2,
+    ) -> Result<Self, LightError> {
+        if width == 0 || height == 0 || texels.len() != width as usize * height as usize {
+            return Err(LightError::InvalidTexture(format!(
+                "{width}x{height} image with {} texels",
+                texels.len()
+            )));
+        }
+        if let Some(bad) = texels
+            .iter()
+            .chain(std::iter::once(&scale))
+            .find(|t| !(t.is_finite() && t.min_element() >= 0.0))
+        {
+            return Err(LightError::InvalidTexture(format!(
+                "texel or scale {bad:?} is negative or not finite"
+            )));
+        }
+        if !texture_from_light.is_finite() {
+            return Err(LightError::InvalidTexture("non-finite uv transform".into()));
+        }
+        let mut t = Self {
+            width,
+            height,
+            texels: texels.into(),
+            scale,
+            texture_from_light,
+            mean: Vec3::ZERO,
+        };
+        // Mean over the light's uv square, by midpoint integration of the filtered texture.
+        let n = 64;
+        let mut sum = Vec3::ZERO;
+        for j in 0..n {
+            for i in 0..n {
+                sum += t.at(Vec2::new(
+                    (i as f32 + 0.5) / n as f32,
+                    (j as f32 + 0.5) / n as f32,
+                ));
+            }
+        }
+        t.mean = sum / (n * n) as f32;
+        Ok(t)
+    }
+
+    /// Image size.
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// Bilinearly filtered radiance at light uv.
+    pub fn at(&self, uv: Vec2) -> Vec3 {
+        let st = self.texture_from_light.transform_point2(uv);
+        let x = st.x * self.width as f32 - 0.5;
+        let y = st.y * self.height as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let texel = |xi: f32, yi: f32| {
+            let xi = (xi as i64).rem_euclid(self.width as i64) as usize;
+            let yi = (yi as i64).rem_euclid(self.height as i64) as usize;
+            self.texels[yi * self.width as usize + xi]
+        };
+        let a = texel(x0, y0).lerp(texel(x0 + 1.0, y0), fx);
+        let b = texel(x0, y0 + 1.0).lerp(texel(x0 + 1.0, y0 + 1.0), fx);
+        a.lerp(b, fy) * self.scale
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn texture_lookup_and_mean() {
+        let tex = TexturedRadiance::new(
+            2,
+            1,
+            vec![Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 1.0)],
+            Vec3::splat(2.0),
+            Affine2::IDENTITY,
+        )
+        .unwrap();
+        // Texel centres return the texel exactly.
+        assert!((tex.at(Vec2::new(0.25, 0.5)) - Vec3::new(2.0, 0.0, 0.0)).length() < 1e-5);
+        assert!((tex.at(Vec2::new(0.75, 0.5)) - Vec3::new(0.0, 0.0, 2.0)).length() < 1e-5);
+        assert!((tex.mean - Vec3::new(1.0, 0.0, 1.0)).length() < 1e-3);
+        assert!(TexturedRadiance::new(0, 0, vec![], Vec3::ONE, Affine2::IDENTITY).is_err());
+        assert!(
+            TexturedRadiance::new(1, 1, vec![Vec3::NAN], Vec3::ONE, Affine2::IDENTITY).is_err()
+        );
+        assert!(Radiance::constant(Vec3::new(-1.0, 0.0, 0.0)).is_err());
+    }
+}

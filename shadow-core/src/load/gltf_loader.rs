@@ -1,0 +1,555 @@
+//! glTF 2.0 loading through the `gltf` crate, with every buffer, accessor and image bound-checked
+//! by hand before reading (DESIGN section 8: Y up, metres; emissive meshes are area lights,
+//! `KHR_materials_emissive_strength` honoured; base-colour alpha of `BLEND` materials is occluder
+//! opacity; the first perspective camera is the view).
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use base64::Engine;
+use glam::{Affine3A, Mat4, Vec2, Vec3};
+use gltf::accessor::{DataType, Dimensions};
+use gltf::mesh::Mode;
+use gltf::{Document, Semantic};
+
+use super::emissive::{EmissiveTexture, light_from_emissive_mesh};
+use super::{LoadError, LoadLimits, SceneSetup, read_limited};
+use crate::camera::Camera;
+use crate::light::Light;
+use crate::scene::{DegeneratePolicy, MeshDesc, PerTriangle, SceneBuilder};
+
+/// Loads a `.gltf` or `.glb` file; external buffers and images are resolved next to it.
+///
+/// # Errors
+/// [`LoadError`] for unreadable, malformed, oversized or unsupported content.
+pub fn load_gltf(path: &Path, limits: &LoadLimits) -> Result<SceneSetup, LoadError> {
+    let bytes = read_limited(path, limits.max_file_bytes)?;
+    let base = path.parent().map(Path::to_path_buf);
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "gltf".into());
+    load_gltf_slice(&bytes, base.as_deref(), &name, limits)
+}
+
+/// Loads glTF from memory; `base` resolves relative URIs (none allowed when `None`).
+///
+/// # Errors
+/// [`LoadError`] for malformed, oversized or unsupported content.
+pub fn load_gltf_slice(
+    bytes: &[u8],
+    base: Option<&Path>,
+    name: &str,
+    limits: &LoadLimits,
+) -> Result<SceneSetup, LoadError> {
+    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| LoadError::Gltf(e.to_string()))?;
+    let doc = gltf.document;
+    let buffers = load_buffers(&doc, gltf.blob, base, limits)?;
+    let mut builder = SceneBuilder::new().degenerate_policy(DegeneratePolicy::Drop);
+    let mut lights: Vec<Light> = Vec::new();
+    let mut camera = None;
+    let mut aspect = None;
+    let mut warnings = Vec::new();
+    let mut vertices_total = 0u64;
+    let mut occluders = 0usize;
+
+    let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
+        Some(s) => s.nodes().collect(),
+        None => doc.nodes().collect(),
+    };
+    let mut stack: Vec<(gltf::Node, Mat4, u32)> = roots
+        .into_iter()
+        .rev()
+        .map(|n| (n, Mat4::IDENTITY, 0))
+        .collect();
+    let mut visited = 0usize;
+    while let Some((node, parent, depth)) = stack.pop() {
+        visited += 1;
+        if depth > 256 || visited > doc.nodes().len() * 4 + 16 {
+            return Err(LoadError::Gltf(
+                "node hierarchy is too deep or cyclic".into(),
+            ));
+        }
+        let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+        let world = parent * local;
+        if !world.is_finite() {
+            return Err(LoadError::Gltf(format!(
+                "node {} has a non-finite transform",
+                node.index()
+            )));
+        }
+        if let Some(cam) = node.camera()
+            && camera.is_none()
+        {
+            match cam.projection() {
+                gltf::camera::Projection::Perspective(p) => {
+                    camera = Some(Camera::from_world_transform(
+                        Affine3A::from_mat4(world),
+                        p.yfov(),
+                    )?);
+                    aspect = p.aspect_ratio();
+                }
+                gltf::camera::Projection::Orthographic(_) => warnings.push(format!(
+                    "camera on node {} is orthographic and was ignored",
+                    node.index()
+                )),
+            }
+        }
+        if let Some(mesh) = node.mesh() {
+            let mesh_name = mesh
+                .name()
+                .map(str::to_string)
+                .unwrap_or_else(|| format!("mesh {}", mesh.index()));
+            for prim in mesh.primitives() {
+                let pos_acc = prim.get(&Semantic::Positions).ok_or_else(|| {
+                    LoadError::Accessor(format!(
+                        "mesh `{mesh_name}` primitive {} has no POSITION",
+                        prim.index()
+                    ))
+                })?;
+                let positions = read_vec3(&buffers, &pos_acc, limits)?;
+                vertices_total += positions.len() as u64;
+                if vertices_total > limits.max_vertices {
+                    return Err(LoadError::Limit {
+                        what: "vertex count".into(),
+                        size: vertices_total,
+                        limit: limits.max_vertices,
+                    });
+                }
+                let indices = match prim.indices() {
+                    Some(a) => read_indices(&buffers, &a, limits)?,
+                    None => (0..positions.len() as u32).collect(),
+                };
+                let triangles = assemble(prim.mode(), &indices, &mesh_name)?;
+                if let Some(&bad) = triangles
+                    .iter()
+                    .flatten()
+                    .find(|&&v| v as usize >= positions.len())
+                {
+                    return Err(LoadError::Accessor(format!(
+                        "mesh `{mesh_name}` index {bad} is out of range for {} vertices",
+                        positions.len()
+                    )));
+                }
+                let material = prim.material();
+                let strength = material.emissive_strength().unwrap_or(1.0);
+                let emission = Vec3::from(material.emissive_factor()) * strength;
+                if emission.max_element() > 0.0 {
+                    let world_pos: Vec<Vec3> = positions
+                        .iter()
+                        .map(|p| world.transform_point3(*p))
+                        .collect();
+                    let texture = match material.emissive_texture() {
+                        Some(info) => {
+                            let tc_acc = prim
+                                .get(&Semantic::TexCoords(info.tex_coord()))
+                                .ok_or_else(|| LoadError::Unsupported {
+                                    mesh: mesh_name.clone(),
+                                    reason: "emissive texture without texture coordinates".into(),
+                                })?;
+                            let texcoords = read_vec2(&buffers, &tc_acc, limits)?;
+                            let (width, height, texels) =
+                                load_image(&doc, &buffers, info.texture().source(), base, limits)?;
+                            Some(EmissiveTexture {
+                                width,
+                                height,
+                                texels,
+                                texcoords,
+                            })
+                        }
+                        None => None,
+                    };
+                    lights.push(light_from_emissive_mesh(
+                        &mesh_name, &world_pos, &triangles, emission, texture,
+                    )?);
+                    continue;
+                }
+                let pbr = material.pbr_metallic_roughness();
+                let base_color = pbr.base_color_factor();
+                let opacity = match material.alpha_mode() {
+                    gltf::material::AlphaMode::Blend => base_color[3].clamp(0.0, 1.0),
+                    _ => 1.0,
+                };
+                let normals = match prim.get(&Semantic::Normals) {
+                    Some(a) => Some(read_vec3(&buffers, &a, limits)?),
+                    None => None,
+                };
+                let mut desc = MeshDesc::new(positions, triangles);
+                desc.normals = normals;
+                desc.opacity = PerTriangle::All(opacity);
+                desc.albedo = PerTriangle::All(
+                    Vec3::new(base_color[0], base_color[1], base_color[2])
+                        .clamp(Vec3::ZERO, Vec3::ONE),
+                );
+                desc.transform = Affine3A::from_mat4(world);
+                builder.push_mesh(desc)?;
+                occluders += 1;
+            }
+        }
+        for child in node.children().collect::<Vec<_>>().into_iter().rev() {
+            stack.push((child, world, depth + 1));
+        }
+    }
+    if occluders == 0 {
+        return Err(LoadError::Unsupported {
+            mesh: name.to_string(),
+            reason: "the file has no non-emissive geometry".into(),
+        });
+    }
+    let scene = builder.build()?;
+    if scene.dropped_degenerate() > 0 {
+        warnings.push(format!(
+            "{} zero-area triangles dropped",
+            scene.dropped_degenerate()
+        ));
+    }
+    Ok(SceneSetup {
+        name: name.to_string(),
+        scene: Arc::new(scene),
+        lights,
+        camera,
+        aspect,
+        warnings,
+    })
+}
+
+fn assemble(mode: Mode, idx: &[u32], mesh: &str) -> Result<Vec<[u32; 3]>, LoadError> {
+    Ok(match mode {
+        Mode::Triangles => idx.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        Mode::TriangleStrip => (2..idx.len())
+            .map(|i| {
+                if i % 2 == 0 {
+                    [idx[i - 2], idx[i - 1], idx[i]]
+                } else {
+                    [idx[i - 1], idx[i - 2], idx[i]]
+                }
+            })
+            .collect(),
+        Mode::TriangleFan => (2..idx.len())
+            .map(|i| [idx[0], idx[i - 1], idx[i]])
+            .collect(),
+        other => {
+            return Err(LoadError::Unsupported {
+                mesh: mesh.to_string(),
+                reason: format!("primitive mode {other:?} has no surface"),
+            });
+        }
+    })
+}
+
+fn decode_data_uri(uri: &str, limit: u64) -> Result<Option<Vec<u8>>, LoadError> {
+    let Some(rest) = uri.strip_prefix("data:") else {
+        return Ok(None);
+    };
+    let (_, data) = rest
+        .split_once(";base64,")
+        .ok_or_else(|| LoadError::Gltf("data URI is not base64".into()))?;
+    let decoded_len = (data.len() as u64 / 4) * 3;
+    if decoded_len > limit {
+        return Err(LoadError::Limit {
+            what: "data URI".into(),
+            size: decoded_len,
+            limit,
+        });
+    }
+    base64::engine::general_purpose::STANDARD
+        .decode(data)
+        .map(Some)
+        .map_err(|e| LoadError::Gltf(format!("bad base64 in data URI: {e}")))
+}
+
+fn resolve(base: Option<&Path>, uri: &str) -> Result<PathBuf, LoadError> {
+    let base = base.ok_or_else(|| {
+        LoadError::Missing(format!("external URI `{uri}` with no base directory"))
+    })?;
+    let uri = uri.replace("%20", " ");
+    if uri.contains("://") || Path::new(&uri).is_absolute() {
+        return Err(LoadError::Unsupported {
+            mesh: uri,
+            reason: "only relative file URIs and data URIs are supported".into(),
+        });
+    }
+    Ok(base.join(uri))
+}
+
+fn load_buffers(
+    doc: &Document,
+    blob: Option<Vec<u8>>,
+    base: Option<&Path>,
+    limits: &LoadLimits,
+) -> Result<Vec<Vec<u8>>, LoadError> {
+    let mut blob = blob;
+    let mut out = Vec::new();
+    for buffer in doc.buffers() {
+        let declared = buffer.length() as u64;
+        if declared > limits.max_buffer_bytes {
+            return Err(LoadError::Limit {
+                what: format!("buffer {}", buffer.index()),
+                size: declared,
+                limit: limits.max_buffer_bytes,
+            });
+        }
+        let data = match buffer.source() {
+            gltf::buffer::Source::Bin => blob.take().ok_or_else(|| {
+                LoadError::Missing(format!(
+                    "buffer {} refers to a missing GLB chunk",
+                    buffer.index()
+                ))
+            })?,
+            gltf::buffer::Source::Uri(uri) => {
+                match decode_data_uri(uri, limits.max_buffer_bytes)? {
+                    Some(d) => d,
+                    None => {
+                        let path = resolve(base, uri)?;
+                        let io = |source| LoadError::Io {
+                            path: path.display().to_string(),
+                            source,
+                        };
+                        let file = std::fs::File::open(&path).map_err(io)?;
+                        let mut d = Vec::new();
+                        file.take(declared).read_to_end(&mut d).map_err(io)?;
+                        d
+                    }
+                }
+            }
+        };
+        if (data.len() as u64) < declared {
+            return Err(LoadError::Limit {
+                what: format!("buffer {} (bytes present)", buffer.index()),
+                size: declared,
+                limit: data.len() as u64,
+            });
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+/// Bound-checked element reader: returns the bytes of each element.
+fn elements<'a>(
+    buffers: &'a [Vec<u8>],
+    acc: &gltf::Accessor,
+    limits: &LoadLimits,
+) -> Result<Vec<&'a [u8]>, LoadError> {
+    if acc.sparse().is_some() {
+        return Err(LoadError::Accessor(format!(
+            "accessor {} is sparse (unsupported)",
+            acc.index()
+        )));
+    }
+    let view = acc.view().ok_or_else(|| {
+        LoadError::Accessor(format!("accessor {} has no buffer view", acc.index()))
+    })?;
+    let buf = buffers
+        .get(view.buffer().index())
+        .ok_or_else(|| LoadError::Missing(format!("buffer {}", view.buffer().index())))?;
+    let (voff, vlen) = (view.offset() as u64, view.length() as u64);
+    if voff + vlen > buf.len() as u64 {
+        return Err(LoadError::Accessor(format!(
+            "buffer view {} exceeds its buffer",
+            view.index()
+        )));
+    }
+    let elem = acc.size() as u64;
+    let stride = view.stride().map(|s| s as u64).unwrap_or(elem);
+    let count = acc.count() as u64;
+    if count > limits.max_vertices * 3 {
+        return Err(LoadError::Limit {
+            what: format!("accessor {} count", acc.index()),
+            size: count,
+            limit: limits.max_vertices * 3,
+        });
+    }
+    if stride < elem {
+        return Err(LoadError::Accessor(format!(
+            "accessor {} stride {stride} below element size {elem}",
+            acc.index()
+        )));
+    }
+    let off = acc.offset() as u64;
+    if count > 0 && off + (count - 1) * stride + elem > vlen {
+        return Err(LoadError::Accessor(format!(
+            "accessor {} reads past its buffer view",
+            acc.index()
+        )));
+    }
+    let start = (voff + off) as usize;
+    Ok((0..count as usize)
+        .map(|i| {
+            let s = start + i * stride as usize;
+            &buf[s..s + elem as usize]
+        })
+        .collect())
+}
+
+fn check_type(acc: &gltf::Accessor, dims: Dimensions, types: &[DataType]) -> Result<(), LoadError> {
+    if acc.dimensions() != dims || !types.contains(&acc.data_type()) {
+        return Err(LoadError::Accessor(format!(
+            "accessor {} is {:?} {:?}, expected {dims:?} of {types:?}",
+            acc.index(),
+            acc.dimensions(),
+            acc.data_type()
+        )));
+    }
+    Ok(())
+}
+
+fn f32_at(b: &[u8], i: usize) -> f32 {
+    f32::from_le_bytes([b[4 * i], b[4 * i + 1], b[4 * i + 2], b[4 * i + 3]])
+}
+
+fn read_vec3(
+    buffers: &[Vec<u8>],
+    acc: &gltf::Accessor,
+    limits: &LoadLimits,
+) -> Result<Vec<Vec3>, LoadError> {
+    check_type(acc, Dimensions::Vec3, &[DataType::F32])?;
+    Ok(elements(buffers, acc, limits)?
+        .into_iter()
+        .map(|b| Vec3::new(f32_at(b, 0), f32_at(b, 1), f32_at(b, 2)))
+        .collect())
+}
+
+fn read_vec2(
+    buffers: &[Vec<u8>],
+    acc: &gltf::Accessor,
+    limits: &LoadLimits,
+) -> Result<Vec<Vec2>, LoadError> {
+    check_type(
+        acc,
+        Dimensions::Vec2,
+        &[DataType::F32, DataType::U8, DataType::U16],
+    )?;
+    let t = acc.data_type();
+    if t != DataType::F32 && !acc.normalized() {
+        return Err(LoadError::Accessor(format!(
+            "accessor {} integer texcoords must be normalized",
+            acc.index()
+        )));
+    }
+    let out: Vec<Vec2> = elements(buffers, acc, limits)?
+        .into_iter()
+        .map(|b| match t {
+            DataType::U8 => Vec2::new(b[0] as f32, b[1] as f32) / 255.0,
+            DataType::U16 => {
+                Vec2::new(
+                    u16::from_le_bytes([b[0], b[1]]) as f32,
+                    u16::from_le_bytes([b[2], b[3]]) as f32,
+                ) / 65535.0
+            }
+            _ => Vec2::new(f32_at(b, 0), f32_at(b, 1)),
+        })
+        .collect();
+    if out.iter().any(|v| !v.is_finite()) {
+        return Err(LoadError::Accessor(format!(
+            "accessor {} has non-finite texcoords",
+            acc.index()
+        )));
+    }
+    Ok(out)
+}
+
+fn read_indices(
+    buffers: &[Vec<u8>],
+    acc: &gltf::Accessor,
+    limits: &LoadLimits,
+) -> Result<Vec<u32>, LoadError> {
+    check_type(
+        acc,
+        Dimensions::Scalar,
+        &[DataType::U8, DataType::U16, DataType::U32],
+    )?;
+    let t = acc.data_type();
+    Ok(elements(buffers, acc, limits)?
+        .into_iter()
+        .map(|b| match t {
+            DataType::U8 => b[0] as u32,
+            DataType::U16 => u16::from_le_bytes([b[0], b[1]]) as u32,
+            _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+        })
+        .collect())
+}
+
+fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+fn load_image(
+    doc: &Document,
+    buffers: &[Vec<u8>],
+    image: gltf::Image,
+    base: Option<&Path>,
+    limits: &LoadLimits,
+) -> Result<(u32, u32, Vec<Vec3>), LoadError> {
+    let _ = doc;
+    let bytes: Vec<u8> = match image.source() {
+        gltf::image::Source::View { view, .. } => {
+            let buf = buffers
+                .get(view.buffer().index())
+                .ok_or_else(|| LoadError::Missing(format!("buffer {}", view.buffer().index())))?;
+            let (o, l) = (view.offset(), view.length());
+            buf.get(o..o + l)
+                .ok_or_else(|| {
+                    LoadError::Texture(format!("image view {} exceeds its buffer", view.index()))
+                })?
+                .to_vec()
+        }
+        gltf::image::Source::Uri { uri, .. } => {
+            match decode_data_uri(uri, limits.max_buffer_bytes)? {
+                Some(d) => d,
+                None => read_limited(&resolve(base, uri)?, limits.max_buffer_bytes)?,
+            }
+        }
+    };
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| LoadError::Texture(e.to_string()))?;
+    let mut lim = image::Limits::default();
+    let side = (limits.max_image_pixels as f64).sqrt().ceil() as u32;
+    lim.max_image_width = Some(side.max(1) * 4);
+    lim.max_image_height = Some(side.max(1) * 4);
+    lim.max_alloc = Some(limits.max_image_pixels * 16);
+    reader.limits(lim);
+    let img = reader
+        .decode()
+        .map_err(|e| LoadError::Texture(e.to_string()))?;
+    let (w, h) = (img.width(), img.height());
+    if w as u64 * h as u64 > limits.max_image_pixels {
+        return Err(LoadError::Limit {
+            what: "texture pixels".into(),
+            size: w as u64 * h as u64,
+            limit: limits.max_image_pixels,
+        });
+    }
+    let rgb = img.to_rgb32f();
+    let linear = !matches!(
+        img,
+        image::DynamicImage::ImageRgb8(_)
+            | image::DynamicImage::ImageRgba8(_)
+            | image::DynamicImage::ImageLuma8(_)
+            | image::DynamicImage::ImageLumaA8(_)
+            | image::DynamicImage::ImageRgb16(_)
+            | image::DynamicImage::ImageRgba16(_)
+    );
+    let texels = rgb
+        .pixels()
+        .map(|p| {
+            let c = Vec3::from(p.0);
+            if linear {
+                c
+            } else {
+                Vec3::new(
+                    srgb_to_linear(c.x),
+                    srgb_to_linear(c.y),
+                    srgb_to_linear(c.z),
+                )
+            }
+        })
+        .collect();
+    Ok((w, h, texels))
+}

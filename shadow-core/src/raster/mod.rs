@@ -1,0 +1,326 @@
+//! A CPU depth rasterizer for camera G-buffers and light-space shadow maps.
+//!
+//! * Perspective (possibly off-centre, as the GBP07 shadow-map frustum of section 3 needs) and
+//!   orthographic projections; triangles are clipped against the near plane in view space.
+//! * Coverage at pixel centres with the top-left fill rule, so a pixel on an edge shared by two
+//!   triangles belongs to exactly one of them; edge functions are evaluated in f64.
+//! * Depth is the linear view-space depth (distance along the view axis), interpolated
+//!   perspective-correctly (`1/d` is affine in screen space).
+//! * `k`-layer depth peeling in one pass: each pixel keeps its `k` nearest fragments with
+//!   strictly increasing depth (BCS06 section 4 takes such layers from the light).
+//! * rayon over bands of rows; triangles are visited in index order inside a band and depth ties
+//!   keep the first, so the result is identical whatever the thread count.
+
+mod setup;
+
+use glam::{Affine3A, Vec3};
+use rayon::prelude::*;
+use thiserror::Error;
+
+use setup::{ScreenTriangle, setup_triangle};
+
+/// Largest `width * height * layers` the rasterizer accepts (256 Mi fragments).
+pub const MAX_FRAGMENTS: u64 = 1 << 28;
+const BAND: u32 = 8;
+
+/// Marks a pixel no triangle covers.
+pub const NO_TRIANGLE: u32 = u32::MAX;
+
+/// A projection from view space (looking down -Z) to the image.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Projection {
+    /// Perspective: the image spans `x/d` in `[left, right]` and `y/d` in `[bottom, top]`
+    /// where `d = -z > near` is the depth.
+    Perspective {
+        /// Left extent at unit depth.
+        left: f32,
+        /// Right extent at unit depth.
+        right: f32,
+        /// Bottom extent at unit depth.
+        bottom: f32,
+        /// Top extent at unit depth.
+        top: f32,
+        /// Near clipping depth (> 0).
+        near: f32,
+    },
+    /// Orthographic: the image spans `x` in `[left, right]`, `y` in `[bottom, top]`, depth `d`
+    /// above `near`.
+    Orthographic {
+        /// Left extent.
+        left: f32,
+        /// Right extent.
+        right: f32,
+        /// Bottom extent.
+        bottom: f32,
+        /// Top extent.
+        top: f32,
+        /// Near clipping depth (may be negative).
+        near: f32,
+    },
+}
+
+/// Everything the rasterizer needs to know about an image.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RasterView {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// View from world (rigid for cameras; any affine map for light frusta).
+    pub view_from_world: Affine3A,
+    /// The projection.
+    pub projection: Projection,
+}
+
+/// Why a rasterization could not run.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum RasterError {
+    /// Zero width or height, or too many fragments.
+    #[error(
+        "image size {width}x{height} with {layers} layers is outside 1..={MAX_FRAGMENTS} fragments"
+    )]
+    Size {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+        /// Layers.
+        layers: u32,
+    },
+    /// The projection has non-finite or empty extents.
+    #[error("projection is invalid: {0}")]
+    Projection(&'static str),
+}
+
+impl RasterView {
+    fn validate(&self, layers: u32) -> Result<(), RasterError> {
+        let n = self.width as u64 * self.height as u64 * layers as u64;
+        if n == 0 || n > MAX_FRAGMENTS {
+            return Err(RasterError::Size {
+                width: self.width,
+                height: self.height,
+                layers,
+            });
+        }
+        if !self.view_from_world.is_finite() {
+            return Err(RasterError::Projection("view transform is not finite"));
+        }
+        let (l, r, b, t, near, persp) = self.extents();
+        if !(l.is_finite() && r.is_finite() && b.is_finite() && t.is_finite() && near.is_finite()) {
+            return Err(RasterError::Projection("non-finite extents"));
+        }
+        if !(r > l && t > b) {
+            return Err(RasterError::Projection("empty extents"));
+        }
+        if persp && !(near > 0.0) {
+            return Err(RasterError::Projection(
+                "perspective near plane must be positive",
+            ));
+        }
+        Ok(())
+    }
+
+    fn extents(&self) -> (f32, f32, f32, f32, f32, bool) {
+        match self.projection {
+            Projection::Perspective {
+                left,
+                right,
+                bottom,
+                top,
+                near,
+            } => (left, right, bottom, top, near, true),
+            Projection::Orthographic {
+                left,
+                right,
+                bottom,
+                top,
+                near,
+            } => (left, right, bottom, top, near, false),
+        }
+    }
+
+    /// The ray through the centre of pixel `(x, y)` (pixel corners at integers, row 0 at the
+    /// top), in world space: origin and unit direction.
+    pub fn pixel_ray(&self, x: u32, y: u32) -> (Vec3, Vec3) {
+        let (l, r, b, t, _, persp) = self.extents();
+        let sx = l + (x as f32 + 0.5) / self.width as f32 * (r - l);
+        let sy = t - (y as f32 + 0.5) / self.height as f32 * (t - b);
+        let world_from_view = self.view_from_world.inverse();
+        if persp {
+            let o = world_from_view.transform_point3(Vec3::ZERO);
+            let d = world_from_view.transform_vector3(Vec3::new(sx, sy, -1.0));
+            (o, d.normalize())
+        } else {
+            let o = world_from_view.transform_point3(Vec3::new(sx, sy, 0.0));
+            let d = world_from_view.transform_vector3(Vec3::NEG_Z);
+            (o, d.normalize())
+        }
+    }
+
+    /// Linear depth of a world point in this view.
+    pub fn depth_of(&self, p: Vec3) -> f32 {
+        -self.view_from_world.transform_point3(p).z
+    }
+}
+
+/// The fragments kept per pixel: triangle ids and linear depths, `layers` per pixel, nearest
+/// first. Unused layers hold [`NO_TRIANGLE`] and `f32::INFINITY`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Fragments {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Layers per pixel.
+    pub layers: u32,
+    /// Triangle id per (pixel, layer): index `(y * width + x) * layers + layer`.
+    pub triangle: Vec<u32>,
+    /// Linear depth per (pixel, layer).
+    pub depth: Vec<f32>,
+}
+
+impl Fragments {
+    /// Triangle id of layer `layer` at pixel `(x, y)`.
+    pub fn triangle_at(&self, x: u32, y: u32, layer: u32) -> u32 {
+        self.triangle[((y * self.width + x) * self.layers + layer) as usize]
+    }
+    /// Depth of layer `layer` at pixel `(x, y)`.
+    pub fn depth_at(&self, x: u32, y: u32, layer: u32) -> f32 {
+        self.depth[((y * self.width + x) * self.layers + layer) as usize]
+    }
+}
+
+/// Rasterizes `triangles` (indices into `positions`) into `layers` depth layers.
+///
+/// # Errors
+/// [`RasterError`] for an invalid view or size. Positions are assumed finite (scenes are
+/// validated); non-finite projected vertices drop their triangle.
+pub fn rasterize(
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    view: &RasterView,
+    layers: u32,
+) -> Result<Fragments, RasterError> {
+    view.validate(layers)?;
+    let (w, h) = (view.width, view.height);
+    let bands = h.div_ceil(BAND) as usize;
+    // Set-up in parallel, binning in triangle order.
+    let setups: Vec<Vec<ScreenTriangle>> = triangles
+        .par_iter()
+        .map(|tri| {
+            let v = tri.map(|i| view.view_from_world.transform_point3(positions[i as usize]));
+            setup_triangle(v, view)
+        })
+        .collect();
+    let mut bins: Vec<Vec<(u32, u32)>> = vec![Vec::new(); bands];
+    for (t, subs) in setups.iter().enumerate() {
+        for (k, s) in subs.iter().enumerate() {
+            let (y0, y1) = (s.ymin / BAND, s.ymax / BAND);
+            for bin in bins.iter_mut().take(y1 as usize + 1).skip(y0 as usize) {
+                bin.push((t as u32, k as u32));
+            }
+        }
+    }
+    let k = layers as usize;
+    let band_len = (BAND * w) as usize * k;
+    let mut tri_out = vec![NO_TRIANGLE; (w * h) as usize * k];
+    let mut depth_out = vec![f32::INFINITY; (w * h) as usize * k];
+    tri_out
+        .par_chunks_mut(band_len)
+        .zip(depth_out.par_chunks_mut(band_len))
+        .enumerate()
+        .for_each(|(band, (tri_band, depth_band))| {
+            let y_lo = band as u32 * BAND;
+            let y_hi = (y_lo + BAND).min(h);
+            for &(t, sub) in &bins[band] {
+                let s = &setups[t as usize][sub as usize];
+                let ys = s.ymin.max(y_lo);
+                let ye = s.ymax.min(y_hi - 1);
+                for y in ys..=ye {
+                    for x in s.xmin..=s.xmax {
+                        let Some(d) = s.depth_at_center(x, y) else {
+                            continue;
+                        };
+                        let base = (((y - y_lo) * w + x) as usize) * k;
+                        insert_layer(
+                            &mut tri_band[base..base + k],
+                            &mut depth_band[base..base + k],
+                            t,
+                            d,
+                        );
+                    }
+                }
+            }
+        });
+    Ok(Fragments {
+        width: w,
+        height: h,
+        layers,
+        triangle: tri_out,
+        depth: depth_out,
+    })
+}
+
+/// Inserts a fragment into a pixel's sorted layer list, keeping depths strictly increasing
+/// (an equal depth keeps the earlier triangle).
+fn insert_layer(tris: &mut [u32], depths: &mut [f32], t: u32, d: f32) {
+    let k = tris.len();
+    let pos = depths.partition_point(|&x| x < d);
+    if pos == k || depths[pos] == d {
+        return;
+    }
+    for i in (pos + 1..k).rev() {
+        tris[i] = tris[i - 1];
+        depths[i] = depths[i - 1];
+    }
+    tris[pos] = t;
+    depths[pos] = d;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn layer_insertion_keeps_strict_order() {
+        let mut t = [NO_TRIANGLE; 3];
+        let mut d = [f32::INFINITY; 3];
+        for (id, depth) in [(0, 5.0), (1, 2.0), (2, 5.0), (3, 9.0), (4, 1.0)] {
+            insert_layer(&mut t, &mut d, id, depth);
+        }
+        assert_eq!(t, [4, 1, 0]);
+        assert_eq!(d, [1.0, 2.0, 5.0]);
+    }
+
+    #[test]
+    fn invalid_views_are_errors() {
+        let view = RasterView {
+            width: 0,
+            height: 4,
+            view_from_world: Affine3A::IDENTITY,
+            projection: Projection::Orthographic {
+                left: -1.0,
+                right: 1.0,
+                bottom: -1.0,
+                top: 1.0,
+                near: 0.0,
+            },
+        };
+        assert!(rasterize(&[], &[], &view, 1).is_err());
+        let v = RasterView {
+            width: 4,
+            projection: Projection::Perspective {
+                left: 1.0,
+                right: -1.0,
+                bottom: -1.0,
+                top: 1.0,
+                near: 0.1,
+            },
+            ..view
+        };
+        assert!(matches!(
+            rasterize(&[], &[], &v, 1),
+            Err(RasterError::Projection(_))
+        ));
+    }
+}

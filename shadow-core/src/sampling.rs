@@ -1,0 +1,216 @@
+//! Light sample sets per pixel, with the strategies of DCS section 5 (Fig. 5): correlated (one
+//! set for all pixels), decorrelated (the set rotated per pixel, a Cranley-Patterson toroidal
+//! shift), stratified (a fresh jittered set per pixel) and interleaved (k x k tiles of sets,
+//! Keller and Heidrich 2001).
+//!
+//! Samples come from a counter-based hash of `(seed, pixel, sample, dimension)`, not from a
+//! sequential generator, so a pixel's samples do not depend on the order or the thread that
+//! asks for them, and a GPU can reproduce them from the same integers.
+
+use glam::{UVec2, Vec2};
+use serde::Serialize;
+use thiserror::Error;
+
+use crate::light::{AreaLight, LightSample};
+
+/// Largest sample count a sampler accepts.
+pub const MAX_SAMPLES: u32 = 1 << 16;
+
+/// How sample sets vary from pixel to pixel (DCS section 5, Fig. 5).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum SamplingStrategy {
+    /// One jittered stratified set shared by every pixel: banding, no noise.
+    Correlated,
+    /// The shared set shifted by a random offset per pixel (toroidal rotation): noise, no banding.
+    Decorrelated,
+    /// An independent jittered stratified set per pixel.
+    Stratified,
+    /// `tile x tile` independent stratified sets repeated over the image.
+    Interleaved {
+        /// Tile side `k` (1 to 64).
+        tile: u32,
+    },
+}
+
+/// Why a sampler could not be built.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum SamplingError {
+    /// The sample count is 0 or above [`MAX_SAMPLES`].
+    #[error("sample count {0} is outside 1..={MAX_SAMPLES}")]
+    Count(u32),
+    /// The interleaving tile is 0 or above 64.
+    #[error("interleaving tile {0} is outside 1..=64")]
+    Tile(u32),
+}
+
+/// SplitMix64 finaliser: a bijective 64-bit mixer.
+pub fn mix64(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// Hash of several words, order-sensitive.
+pub fn hash_words(words: &[u64]) -> u64 {
+    words.iter().fold(0x9e37_79b9_7f4a_7c15u64, |h, &w| {
+        mix64(h ^ mix64(w.wrapping_add(h)))
+    })
+}
+
+/// A float in `[0, 1)` from the top 24 bits of a hash.
+pub fn unit_float(h: u64) -> f32 {
+    (h >> 40) as f32 * (1.0 / 16_777_216.0)
+}
+
+const ONE_MINUS: f32 = 1.0 - 1.0 / 16_777_216.0;
+
+/// A seeded, reproducible source of per-pixel light sample sets.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LightSampler {
+    strategy: SamplingStrategy,
+    count: u32,
+    seed: u64,
+    grid: UVec2,
+    /// Shared sets: one for correlated/decorrelated, `tile^2` for interleaved.
+    sets: Vec<Vec<Vec2>>,
+}
+
+impl LightSampler {
+    /// A sampler drawing `count` samples per pixel.
+    ///
+    /// # Errors
+    /// [`SamplingError`] for a count outside `1..=MAX_SAMPLES` or a bad tile size.
+    pub fn new(strategy: SamplingStrategy, count: u32, seed: u64) -> Result<Self, SamplingError> {
+        if count == 0 || count > MAX_SAMPLES {
+            return Err(SamplingError::Count(count));
+        }
+        let grid = strata(count);
+        let mut s = Self {
+            strategy,
+            count,
+            seed,
+            grid,
+            sets: Vec::new(),
+        };
+        s.sets = match strategy {
+            SamplingStrategy::Correlated | SamplingStrategy::Decorrelated => {
+                vec![s.jittered_set(&[seed, 0x5e7])]
+            }
+            SamplingStrategy::Stratified => Vec::new(),
+            SamplingStrategy::Interleaved { tile } => {
+                if tile == 0 || tile > 64 {
+                    return Err(SamplingError::Tile(tile));
+                }
+                (0..tile * tile)
+                    .map(|k| s.jittered_set(&[seed, 0x11, k as u64]))
+                    .collect()
+            }
+        };
+        Ok(s)
+    }
+
+    /// The strategy.
+    pub fn strategy(&self) -> SamplingStrategy {
+        self.strategy
+    }
+    /// Samples per pixel.
+    pub fn count(&self) -> u32 {
+        self.count
+    }
+    /// The seed.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+    /// The stratification grid (`x * y = count`).
+    pub fn grid(&self) -> UVec2 {
+        self.grid
+    }
+
+    /// A jittered set: one uniform point in each cell of the grid, cells in row-major order.
+    fn jittered_set(&self, key: &[u64]) -> Vec<Vec2> {
+        let mut out = Vec::with_capacity(self.count as usize);
+        for k in 0..self.count {
+            let (cx, cy) = (k % self.grid.x, k / self.grid.x);
+            let mut words = key.to_vec();
+            words.push(k as u64);
+            let h = hash_words(&words);
+            let jx = unit_float(h);
+            let jy = unit_float(mix64(h));
+            out.push(Vec2::new(
+                ((cx as f32 + jx) / self.grid.x as f32).min(ONE_MINUS),
+                ((cy as f32 + jy) / self.grid.y as f32).min(ONE_MINUS),
+            ));
+        }
+        out
+    }
+
+    /// The unit-square samples of pixel `pixel` (x, y), written into `out` (cleared first).
+    pub fn unit_samples(&self, pixel: UVec2, out: &mut Vec<Vec2>) {
+        out.clear();
+        match self.strategy {
+            SamplingStrategy::Correlated => out.extend_from_slice(&self.sets[0]),
+            SamplingStrategy::Decorrelated => {
+                let h = hash_words(&[self.seed, 0xdec, pixel.x as u64, pixel.y as u64]);
+                let shift = Vec2::new(unit_float(h), unit_float(mix64(h)));
+                out.extend(self.sets[0].iter().map(|u| {
+                    let s = *u + shift;
+                    (s - s.floor()).min(Vec2::splat(ONE_MINUS))
+                }));
+            }
+            SamplingStrategy::Stratified => {
+                out.extend(self.jittered_set(&[self.seed, 0x57, pixel.x as u64, pixel.y as u64]))
+            }
+            SamplingStrategy::Interleaved { tile } => {
+                let k = (pixel.y % tile) * tile + pixel.x % tile;
+                out.extend_from_slice(&self.sets[k as usize]);
+            }
+        }
+    }
+
+    /// The light samples of pixel `pixel`, written into `out` (cleared first).
+    pub fn light_samples(&self, light: &dyn AreaLight, pixel: UVec2, out: &mut Vec<LightSample>) {
+        let mut u = Vec::with_capacity(self.count as usize);
+        self.unit_samples(pixel, &mut u);
+        out.clear();
+        out.extend(u.iter().map(|u| light.sample(*u)));
+    }
+}
+
+/// Grid `(x, y)` with `x * y = count` and `x` the largest divisor not above `sqrt(count)`.
+fn strata(count: u32) -> UVec2 {
+    let mut x = (count as f64).sqrt().floor() as u32;
+    while x > 1 && count % x != 0 {
+        x -= 1;
+    }
+    let x = x.max(1);
+    UVec2::new(count / x, x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strata_multiply_to_count() {
+        for n in [1, 2, 7, 16, 64, 128, 1000, 1024, 4096] {
+            let g = strata(n);
+            assert_eq!(g.x * g.y, n);
+            assert!(g.x >= g.y);
+        }
+        assert_eq!(strata(1024), UVec2::new(32, 32));
+        assert_eq!(strata(128), UVec2::new(16, 8));
+    }
+
+    #[test]
+    fn bad_parameters_are_errors() {
+        assert_eq!(
+            LightSampler::new(SamplingStrategy::Stratified, 0, 1),
+            Err(SamplingError::Count(0))
+        );
+        assert!(LightSampler::new(SamplingStrategy::Stratified, MAX_SAMPLES + 1, 1).is_err());
+        assert_eq!(
+            LightSampler::new(SamplingStrategy::Interleaved { tile: 0 }, 4, 1),
+            Err(SamplingError::Tile(0))
+        );
+    }
+}

@@ -1,0 +1,210 @@
+//! View samples (the G-buffer): per pixel the first surface hit through the pixel centre, shared
+//! by every technique and the reference so that differences come from shadows alone
+//! (DESIGN section 3).
+//!
+//! The rasterizer decides which triangle a pixel sees; the position is then the exact
+//! intersection of the pixel's camera ray with that triangle's plane (computed in f64), so it
+//! equals a ray tracer's hit point rather than an interpolated approximation.
+
+use glam::{DVec3, UVec2, Vec3};
+use rayon::prelude::*;
+
+use crate::camera::Camera;
+use crate::raster::{NO_TRIANGLE, RasterError, RasterView, rasterize};
+use crate::scene::Scene;
+
+/// The G-buffer of one camera view.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ViewSamples {
+    width: u32,
+    height: u32,
+    camera_position: Vec3,
+    position: Vec<Vec3>,
+    geometric_normal: Vec<Vec3>,
+    shading_normal: Vec<Vec3>,
+    triangle: Vec<u32>,
+    depth: Vec<f32>,
+}
+
+/// One valid view sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ViewSample {
+    /// Pixel coordinates.
+    pub pixel: UVec2,
+    /// World position on the surface.
+    pub position: Vec3,
+    /// Unit geometric normal, flipped to face the camera.
+    pub geometric_normal: Vec3,
+    /// Unit shading normal (interpolated, on the camera's side like the geometric normal).
+    pub shading_normal: Vec3,
+    /// Triangle id.
+    pub triangle: u32,
+    /// Linear depth along the camera axis.
+    pub depth: f32,
+}
+
+impl ViewSamples {
+    /// Renders the view samples of `scene` seen by `camera` at `width x height`.
+    ///
+    /// # Errors
+    /// [`RasterError`] for a zero or too large image.
+    pub fn render(
+        scene: &dyn Scene,
+        camera: &Camera,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, RasterError> {
+        let view = camera.raster_view(width, height);
+        Self::render_view(scene, &view)
+    }
+
+    /// Renders the view samples for any raster view (perspective or orthographic).
+    ///
+    /// # Errors
+    /// [`RasterError`] for an invalid view.
+    pub fn render_view(scene: &dyn Scene, view: &RasterView) -> Result<Self, RasterError> {
+        let frags = rasterize(scene.positions(), scene.triangles(), view, 1)?;
+        let (w, h) = (view.width, view.height);
+        let world_from_view = view.view_from_world.inverse();
+        let camera_position = world_from_view.transform_point3(Vec3::ZERO);
+        let n = (w * h) as usize;
+        let mut position = vec![Vec3::ZERO; n];
+        let mut geometric_normal = vec![Vec3::ZERO; n];
+        let mut shading_normal = vec![Vec3::ZERO; n];
+        let mut depth = vec![f32::INFINITY; n];
+        let mut triangle = frags.triangle.clone();
+        let normals = scene.shading_normals();
+        position
+            .par_iter_mut()
+            .zip(geometric_normal.par_iter_mut())
+            .zip(shading_normal.par_iter_mut())
+            .zip(depth.par_iter_mut())
+            .zip(triangle.par_iter_mut())
+            .enumerate()
+            .for_each(|(i, ((((pos, gn), sn), d), tri))| {
+                if *tri == NO_TRIANGLE {
+                    return;
+                }
+                let (x, y) = (i as u32 % w, i as u32 / w);
+                let (o, dir) = view.pixel_ray(x, y);
+                let t = *tri as usize;
+                let [a, b, c] = scene.triangle(t);
+                let (a64, b64, c64) = (a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
+                let n64 = (b64 - a64).cross(c64 - a64);
+                let (o64, d64) = (o.as_dvec3(), dir.as_dvec3());
+                let denom = n64.dot(d64);
+                let hit = if denom != 0.0 {
+                    let s = n64.dot(a64 - o64) / denom;
+                    o64 + d64 * s
+                } else {
+                    // Edge-on triangle: fall back to the rasterized depth along the ray.
+                    o64 + d64 * frags.depth[i] as f64
+                };
+                if !hit.is_finite() {
+                    *tri = NO_TRIANGLE;
+                    return;
+                }
+                let geo = n64.normalize();
+                let flip = geo.dot(d64) > 0.0;
+                let geo = if flip { -geo } else { geo };
+                let shading = match normals {
+                    Some(ns) => {
+                        let [ia, ib, ic] = scene.triangles()[t];
+                        let bary = barycentric(a64, b64, c64, n64, hit);
+                        let s = ns[ia as usize].as_dvec3() * bary.x
+                            + ns[ib as usize].as_dvec3() * bary.y
+                            + ns[ic as usize].as_dvec3() * bary.z;
+                        let s = s.try_normalize().unwrap_or(geo);
+                        if flip { -s } else { s }
+                    }
+                    None => geo,
+                };
+                *pos = hit.as_vec3();
+                *gn = geo.as_vec3();
+                *sn = shading.as_vec3();
+                *d = view.depth_of(*pos);
+            });
+        Ok(Self {
+            width: w,
+            height: h,
+            camera_position,
+            position,
+            geometric_normal,
+            shading_normal,
+            triangle,
+            depth,
+        })
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+    /// Height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+    /// Number of pixels.
+    pub fn len(&self) -> usize {
+        self.triangle.len()
+    }
+    /// True for a 0-pixel buffer (never produced by [`ViewSamples::render`]).
+    pub fn is_empty(&self) -> bool {
+        self.triangle.is_empty()
+    }
+    /// Position of the camera (ray origin of perspective views).
+    pub fn camera_position(&self) -> Vec3 {
+        self.camera_position
+    }
+    /// True when pixel `i` (row-major) sees a surface.
+    pub fn is_valid(&self, i: usize) -> bool {
+        self.triangle[i] != NO_TRIANGLE
+    }
+    /// The valid-pixel mask, row-major.
+    pub fn valid_mask(&self) -> Vec<bool> {
+        self.triangle.iter().map(|&t| t != NO_TRIANGLE).collect()
+    }
+    /// Number of valid pixels.
+    pub fn valid_count(&self) -> usize {
+        self.triangle.iter().filter(|&&t| t != NO_TRIANGLE).count()
+    }
+    /// The sample of pixel `i`, `None` for background.
+    pub fn get(&self, i: usize) -> Option<ViewSample> {
+        self.is_valid(i).then(|| ViewSample {
+            pixel: UVec2::new(i as u32 % self.width, i as u32 / self.width),
+            position: self.position[i],
+            geometric_normal: self.geometric_normal[i],
+            shading_normal: self.shading_normal[i],
+            triangle: self.triangle[i],
+            depth: self.depth[i],
+        })
+    }
+    /// Positions, row-major (zero for background).
+    pub fn positions(&self) -> &[Vec3] {
+        &self.position
+    }
+    /// Geometric normals, row-major (zero for background).
+    pub fn geometric_normals(&self) -> &[Vec3] {
+        &self.geometric_normal
+    }
+    /// Shading normals, row-major (zero for background).
+    pub fn shading_normals(&self) -> &[Vec3] {
+        &self.shading_normal
+    }
+    /// Triangle ids, row-major ([`NO_TRIANGLE`] for background).
+    pub fn triangles(&self) -> &[u32] {
+        &self.triangle
+    }
+    /// Linear depths, row-major (infinite for background).
+    pub fn depths(&self) -> &[f32] {
+        &self.depth
+    }
+}
+
+/// Barycentric coordinates of `p` (on the plane of `a, b, c` with normal `n`).
+fn barycentric(a: DVec3, b: DVec3, c: DVec3, n: DVec3, p: DVec3) -> DVec3 {
+    let nn = n.length_squared();
+    let wa = (c - b).cross(p - b).dot(n) / nn;
+    let wb = (a - c).cross(p - c).dot(n) / nn;
+    DVec3::new(wa, wb, 1.0 - wa - wb)
+}

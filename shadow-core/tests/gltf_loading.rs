@@ -1,0 +1,455 @@
+//! glTF loading of files the test writes itself: emissive rectangle, disk and textured quad,
+//! a camera and a semi-opaque mesh; and malformed files that must give errors.
+
+use std::f32::consts::TAU;
+use std::io::Cursor;
+
+use base64::Engine;
+use glam::{Vec2, Vec3};
+use serde_json::{Value, json};
+use shadow_core::light::{LightGeometry, LightKind};
+use shadow_core::load::{LoadError, LoadLimits, load_gltf, load_gltf_slice};
+use shadow_core::prelude::*;
+
+/// A tiny glTF writer: one binary buffer, one accessor set per mesh.
+#[derive(Default)]
+struct Writer {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+    meshes: Vec<Value>,
+    materials: Vec<Value>,
+    images: Vec<Value>,
+}
+
+impl Writer {
+    fn view(&mut self, bytes: &[u8], target: Option<u32>) -> usize {
+        while self.bin.len() % 4 != 0 {
+            self.bin.push(0);
+        }
+        let offset = self.bin.len();
+        self.bin.extend_from_slice(bytes);
+        let mut v = json!({"buffer": 0, "byteOffset": offset, "byteLength": bytes.len()});
+        if let Some(t) = target {
+            v["target"] = json!(t);
+        }
+        self.views.push(v);
+        self.views.len() - 1
+    }
+
+    fn accessor(&mut self, view: usize, ctype: u32, count: usize, ty: &str, extra: Value) -> usize {
+        let mut a = json!({"bufferView": view, "componentType": ctype, "count": count, "type": ty});
+        if let Value::Object(m) = extra {
+            for (k, v) in m {
+                a[k] = v;
+            }
+        }
+        self.accessors.push(a);
+        self.accessors.len() - 1
+    }
+
+    fn material(&mut self, m: Value) -> usize {
+        self.materials.push(m);
+        self.materials.len() - 1
+    }
+
+    fn mesh(
+        &mut self,
+        name: &str,
+        pos: &[Vec3],
+        idx: &[u32],
+        uv: Option<&[Vec2]>,
+        material: usize,
+    ) -> usize {
+        let pb: Vec<u8> = pos
+            .iter()
+            .flat_map(|p| p.to_array())
+            .flat_map(f32::to_le_bytes)
+            .collect();
+        let (lo, hi) = pos
+            .iter()
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), p| {
+                (a.min(*p), b.max(*p))
+            });
+        let pv = self.view(&pb, Some(34962));
+        let pa = self.accessor(
+            pv,
+            5126,
+            pos.len(),
+            "VEC3",
+            json!({"min": lo.to_array(), "max": hi.to_array()}),
+        );
+        let ib: Vec<u8> = idx.iter().flat_map(|i| (*i as u16).to_le_bytes()).collect();
+        let iv = self.view(&ib, Some(34963));
+        let ia = self.accessor(iv, 5123, idx.len(), "SCALAR", json!({}));
+        let mut attrs = json!({"POSITION": pa});
+        if let Some(uv) = uv {
+            let ub: Vec<u8> = uv
+                .iter()
+                .flat_map(|p| p.to_array())
+                .flat_map(f32::to_le_bytes)
+                .collect();
+            let uvv = self.view(&ub, Some(34962));
+            attrs["TEXCOORD_0"] = json!(self.accessor(uvv, 5126, uv.len(), "VEC2", json!({})));
+        }
+        self.meshes.push(json!({"name": name, "primitives": [{"attributes": attrs, "indices": ia, "material": material}]}));
+        self.meshes.len() - 1
+    }
+
+    fn png_image(&mut self, w: u32, h: u32, rgb: &[[u8; 3]]) -> usize {
+        let img = image::RgbImage::from_fn(w, h, |x, y| image::Rgb(rgb[(y * w + x) as usize]));
+        let mut png = Vec::new();
+        img.write_to(&mut Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        let v = self.view(&png, None);
+        self.images
+            .push(json!({"bufferView": v, "mimeType": "image/png"}));
+        self.images.len() - 1
+    }
+
+    fn document(&self, nodes: Value, cameras: Value) -> Value {
+        let n = nodes.as_array().unwrap().len();
+        let b64 = base64::engine::general_purpose::STANDARD.encode(&self.bin);
+        let mut doc = json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["KHR_materials_emissive_strength"],
+            "scene": 0,
+            "scenes": [{"nodes": (0..n).collect::<Vec<_>>()}],
+            "nodes": nodes,
+            "meshes": self.meshes,
+            "materials": self.materials,
+            "buffers": [{"byteLength": self.bin.len(), "uri": format!("data:application/octet-stream;base64,{b64}")}],
+            "bufferViews": self.views,
+            "accessors": self.accessors,
+        });
+        if !cameras.as_array().unwrap().is_empty() {
+            doc["cameras"] = cameras;
+        }
+        if !self.images.is_empty() {
+            doc["images"] = json!(self.images);
+            doc["textures"] = json!(
+                (0..self.images.len())
+                    .map(|i| json!({"source": i}))
+                    .collect::<Vec<_>>()
+            );
+        }
+        doc
+    }
+}
+
+fn square(half: f32) -> (Vec<Vec3>, Vec<u32>) {
+    // In the XZ plane, wound so the normal points down (-Y), as a ceiling light.
+    (
+        vec![
+            Vec3::new(-half, 0.0, -half),
+            Vec3::new(half, 0.0, -half),
+            Vec3::new(half, 0.0, half),
+            Vec3::new(-half, 0.0, half),
+        ],
+        vec![0, 1, 2, 0, 2, 3],
+    )
+}
+
+fn disk(r: f32, n: u32) -> (Vec<Vec3>, Vec<u32>) {
+    let mut p = vec![Vec3::ZERO];
+    let mut idx = Vec::new();
+    for i in 0..n {
+        let a = TAU * i as f32 / n as f32;
+        p.push(Vec3::new(r * a.cos(), 0.0, r * a.sin()));
+        idx.extend([0, 1 + i, 1 + (i + 1) % n]);
+    }
+    (p, idx)
+}
+
+fn test_document() -> Value {
+    let mut w = Writer::default();
+    let grey =
+        w.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.6, 0.7, 1.0]}}));
+    let glass = w.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 0.4]}, "alphaMode": "BLEND"}));
+    let masked = w.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 0.4]}, "alphaMode": "MASK"}));
+    let lamp = w.material(json!({"emissiveFactor": [1.0, 0.5, 0.25], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4.0}}}));
+    let image = w.png_image(2, 1, &[[255, 0, 0], [0, 0, 255]]);
+    let textured =
+        w.material(json!({"emissiveFactor": [1.0, 1.0, 1.0], "emissiveTexture": {"index": image}}));
+    let (fp, fi) = square(3.0);
+    let floor_idx: Vec<u32> = fi.chunks(3).flat_map(|c| [c[0], c[2], c[1]]).collect();
+    w.mesh("floor", &fp, &floor_idx, None, grey);
+    let (sp, si) = square(0.5);
+    w.mesh("glass", &sp, &si, None, glass);
+    w.mesh("masked", &sp, &si, None, masked);
+    w.mesh("rect-lamp", &sp, &si, None, lamp);
+    let (dp, di) = disk(0.3, 48);
+    w.mesh("disk-lamp", &dp, &di, None, lamp);
+    let uv = [
+        Vec2::new(0.0, 0.0),
+        Vec2::new(1.0, 0.0),
+        Vec2::new(1.0, 1.0),
+        Vec2::new(0.0, 1.0),
+    ];
+    w.mesh("textured-lamp", &sp, &si, Some(&uv), textured);
+    let nodes = json!([
+        {"mesh": 0},
+        {"mesh": 1, "translation": [0.0, 1.0, 0.0]},
+        {"mesh": 2, "translation": [0.0, 1.5, 0.0]},
+        {"mesh": 3, "translation": [0.0, 3.0, 0.0], "scale": [2.0, 1.0, 1.0]},
+        {"mesh": 4, "translation": [1.0, 3.0, 0.0]},
+        {"mesh": 5, "translation": [-1.0, 3.0, 0.0]},
+        {"camera": 0, "translation": [0.0, 2.0, 6.0]}
+    ]);
+    w.document(nodes, json!([{"type": "perspective", "perspective": {"yfov": 0.8, "aspectRatio": 1.5, "znear": 0.01}}]))
+}
+
+fn load(doc: &Value) -> Result<SceneSetup, LoadError> {
+    load_gltf_slice(
+        doc.to_string().as_bytes(),
+        None,
+        "test",
+        &LoadLimits::default(),
+    )
+}
+
+#[test]
+fn lights_camera_and_opacities_load_as_written() {
+    let setup = load(&test_document()).unwrap();
+    assert_eq!(setup.lights.len(), 3);
+    // Rectangle: scaled by 2 along x -> 2 x 1, emission x strength.
+    let rect = &setup.lights[0];
+    assert_eq!(rect.kind(), LightKind::Rectangle);
+    assert!((rect.area() - 2.0).abs() < 1e-5);
+    assert!((rect.center() - Vec3::new(0.0, 3.0, 0.0)).length() < 1e-5);
+    match rect.geometry() {
+        LightGeometry::Rectangle { normal, .. } => assert!((normal - Vec3::NEG_Y).length() < 1e-5),
+        g => panic!("expected a rectangle, got {g:?}"),
+    }
+    assert!((rect.radiance().mean() - Vec3::new(4.0, 2.0, 1.0)).length() < 1e-5);
+    // Disk: recognised exactly (48 rim vertices).
+    let disk = &setup.lights[1];
+    match disk.geometry() {
+        LightGeometry::Disk {
+            center,
+            radius,
+            normal,
+        } => {
+            assert!((center - Vec3::new(1.0, 3.0, 0.0)).length() < 1e-5);
+            assert!((radius - 0.3).abs() < 1e-5);
+            assert!((normal - Vec3::NEG_Y).length() < 1e-5);
+        }
+        g => panic!("expected a disk, got {g:?}"),
+    }
+    // Textured: red at uv u < 0.5, blue at u > 0.5 (sRGB 255 -> linear 1).
+    let tex = &setup.lights[2];
+    assert!(tex.is_textured());
+    assert_eq!(tex.kind(), LightKind::Rectangle);
+    // Texture u follows the mesh's x (vertex x = -0.5 has u = 0; node at x = -1), so texel
+    // centres u = 0.25 (red) and 0.75 (blue) sit at world x = -1.25 and -0.75.
+    let (mut reds, mut blues) = (0, 0);
+    for j in 0..64 {
+        for i in 0..64 {
+            let s = tex.sample(Vec2::new((i as f32 + 0.5) / 64.0, (j as f32 + 0.5) / 64.0));
+            if (s.position.x + 1.25).abs() < 0.01 {
+                assert!(
+                    (s.radiance - Vec3::new(1.0, 0.0, 0.0)).length() < 0.05,
+                    "{:?}",
+                    s.radiance
+                );
+                reds += 1;
+            }
+            if (s.position.x + 0.75).abs() < 0.01 {
+                assert!(
+                    (s.radiance - Vec3::new(0.0, 0.0, 1.0)).length() < 0.05,
+                    "{:?}",
+                    s.radiance
+                );
+                blues += 1;
+            }
+        }
+    }
+    assert!(reds > 0 && blues > 0);
+    // Camera.
+    let cam = setup.camera.unwrap();
+    assert!((cam.position() - Vec3::new(0.0, 2.0, 6.0)).length() < 1e-5);
+    assert!((cam.forward() - Vec3::NEG_Z).length() < 1e-5);
+    assert!((cam.yfov() - 0.8).abs() < 1e-6);
+    assert_eq!(setup.aspect, Some(1.5));
+    // Opacities: floor opaque, BLEND glass 0.4, MASK ignores alpha.
+    let s = &setup.scene;
+    assert_eq!(s.triangle_count(), 6);
+    assert_eq!(s.opacities(), &[1.0, 1.0, 0.4, 0.4, 1.0, 1.0]);
+    assert!((s.albedo(0) - Vec3::new(0.5, 0.6, 0.7)).length() < 1e-6);
+    assert!(s.has_semi_opaque());
+}
+
+#[test]
+fn glb_and_external_buffers_load() {
+    let dir = std::env::temp_dir().join(format!("shadow-core-gltf-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // External .bin next to the .gltf.
+    let mut doc = test_document();
+    let uri = doc["buffers"][0]["uri"].as_str().unwrap().to_string();
+    let bin = base64::engine::general_purpose::STANDARD
+        .decode(uri.split_once(";base64,").unwrap().1)
+        .unwrap();
+    std::fs::write(dir.join("scene data.bin"), &bin).unwrap();
+    doc["buffers"][0]["uri"] = json!("scene%20data.bin");
+    std::fs::write(dir.join("scene.gltf"), doc.to_string()).unwrap();
+    let external = load_gltf(&dir.join("scene.gltf"), &LoadLimits::default()).unwrap();
+    assert_eq!(external.lights.len(), 3);
+    // GLB: JSON chunk + BIN chunk.
+    let mut glb_doc = test_document();
+    glb_doc["buffers"][0] = json!({"byteLength": bin.len()});
+    let glb = make_glb(&glb_doc.to_string(), &bin);
+    std::fs::write(dir.join("scene.glb"), &glb).unwrap();
+    let from_glb = load_gltf(&dir.join("scene.glb"), &LoadLimits::default()).unwrap();
+    assert_eq!(from_glb.lights.len(), 3);
+    assert_eq!(from_glb.scene.triangle_count(), 6);
+    // Truncated GLB.
+    std::fs::write(dir.join("cut.glb"), &glb[..glb.len() / 2]).unwrap();
+    assert!(load_gltf(&dir.join("cut.glb"), &LoadLimits::default()).is_err());
+    // Missing external buffer.
+    std::fs::remove_file(dir.join("scene data.bin")).unwrap();
+    assert!(matches!(
+        load_gltf(&dir.join("scene.gltf"), &LoadLimits::default()),
+        Err(LoadError::Io { .. })
+    ));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+fn make_glb(json_text: &str, bin: &[u8]) -> Vec<u8> {
+    let mut j = json_text.as_bytes().to_vec();
+    while j.len() % 4 != 0 {
+        j.push(b' ');
+    }
+    let mut b = bin.to_vec();
+    while b.len() % 4 != 0 {
+        b.push(0);
+    }
+    let total = 12 + 8 + j.len() + 8 + b.len();
+    let mut out = Vec::new();
+    out.extend(b"glTF");
+    out.extend(2u32.to_le_bytes());
+    out.extend((total as u32).to_le_bytes());
+    out.extend((j.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(j);
+    out.extend((b.len() as u32).to_le_bytes());
+    out.extend(b"BIN\0");
+    out.extend(b);
+    out
+}
+
+#[test]
+fn malformed_gltf_gives_errors() {
+    let limits = LoadLimits::default();
+    assert!(matches!(
+        load_gltf_slice(b"not json at all", None, "x", &limits),
+        Err(LoadError::Gltf(_))
+    ));
+    assert!(load_gltf_slice(b"{\"asset\":{\"version\":\"2.0\"}}", None, "x", &limits).is_err());
+
+    // Absurd declared buffer size.
+    let mut doc = test_document();
+    doc["buffers"][0]["byteLength"] = json!(1u64 << 50);
+    assert!(matches!(load(&doc), Err(LoadError::Limit { .. })));
+    // Declared size larger than the data present.
+    let mut doc = test_document();
+    let n = doc["buffers"][0]["byteLength"].as_u64().unwrap();
+    doc["buffers"][0]["byteLength"] = json!(n + 1000);
+    assert!(matches!(
+        load(&doc),
+        Err(LoadError::Limit { .. }) | Err(LoadError::Gltf(_))
+    ));
+    // Accessor reading past its view.
+    let mut doc = test_document();
+    doc["accessors"][0]["count"] = json!(1_000_000);
+    assert!(matches!(
+        load(&doc),
+        Err(LoadError::Accessor(_)) | Err(LoadError::Gltf(_))
+    ));
+    // Buffer view past the buffer.
+    let mut doc = test_document();
+    doc["bufferViews"][0]["byteLength"] = json!(1u64 << 40);
+    assert!(load(&doc).is_err());
+    // External buffer with no base directory.
+    let mut doc = test_document();
+    doc["buffers"][0]["uri"] = json!("missing.bin");
+    assert!(matches!(load(&doc), Err(LoadError::Missing(_))));
+    // Index out of range.
+    let mut doc = test_document();
+    doc["accessors"][0]["count"] = json!(2);
+    doc["accessors"][0]["min"] = json!([0.0, 0.0, 0.0]);
+    assert!(matches!(load(&doc), Err(LoadError::Accessor(_))));
+    // Wrong accessor type for positions.
+    let mut doc = test_document();
+    doc["accessors"][0]["type"] = json!("VEC2");
+    doc["accessors"][0].as_object_mut().unwrap().remove("min");
+    doc["accessors"][0].as_object_mut().unwrap().remove("max");
+    assert!(load(&doc).is_err());
+    // Non-finite vertex data gives a scene error.
+    let mut w = Writer::default();
+    let m = w.material(json!({}));
+    w.mesh(
+        "bad",
+        &[Vec3::ZERO, Vec3::X, Vec3::new(f32::NAN, 0.0, 1.0)],
+        &[0, 1, 2],
+        None,
+        m,
+    );
+    let mut doc = w.document(json!([{"mesh": 0}]), json!([]));
+    doc["accessors"][0]["min"] = json!([0.0, 0.0, 0.0]);
+    doc["accessors"][0]["max"] = json!([1.0, 0.0, 1.0]);
+    assert!(matches!(load(&doc), Err(LoadError::Scene(_))));
+    // Bad base64.
+    let mut doc = test_document();
+    doc["buffers"][0]["uri"] = json!("data:application/octet-stream;base64,@@@@");
+    assert!(load(&doc).is_err());
+}
+
+#[test]
+fn unsupported_emissive_shapes_name_the_mesh() {
+    let mut w = Writer::default();
+    let grey = w.material(json!({}));
+    let lamp = w.material(json!({"emissiveFactor": [1.0, 1.0, 1.0]}));
+    let (fp, fi) = square(3.0);
+    w.mesh("floor", &fp, &fi, None, grey);
+    // An open, bent emissive mesh: neither planar nor a closed sphere.
+    let bent = [
+        Vec3::ZERO,
+        Vec3::X,
+        Vec3::new(1.0, 0.0, 1.0),
+        Vec3::new(0.0, 1.0, 1.0),
+    ];
+    w.mesh("bent-lamp", &bent, &[0, 1, 2, 0, 2, 3], None, lamp);
+    let doc = w.document(json!([{"mesh": 0}, {"mesh": 1}]), json!([]));
+    match load(&doc) {
+        Err(LoadError::Unsupported { mesh, reason }) => {
+            assert_eq!(mesh, "bent-lamp");
+            assert!(reason.contains("planar"), "{reason}");
+        }
+        other => panic!("expected Unsupported, got {other:?}"),
+    }
+}
+
+#[test]
+fn emissive_sphere_becomes_a_sphere_light() {
+    let mut w = Writer::default();
+    let grey = w.material(json!({}));
+    let lamp = w.material(json!({"emissiveFactor": [2.0, 2.0, 2.0]}));
+    let (fp, fi) = square(3.0);
+    w.mesh("floor", &fp, &fi, None, grey);
+    let (sp, st) = shadow_core::procedural::uv_sphere(Vec3::ZERO, 0.25, 12, 24);
+    let si: Vec<u32> = st.iter().flatten().copied().collect();
+    w.mesh("bulb", &sp, &si, None, lamp);
+    let doc = w.document(
+        json!([{"mesh": 0}, {"mesh": 1, "translation": [0.0, 2.0, 0.0]}]),
+        json!([]),
+    );
+    let setup = load(&doc).unwrap();
+    match setup.lights[0].geometry() {
+        LightGeometry::Sphere { center, radius } => {
+            assert!((center - Vec3::new(0.0, 2.0, 0.0)).length() < 1e-4);
+            assert!((radius - 0.25).abs() < 1e-3);
+        }
+        g => panic!("expected a sphere, got {g:?}"),
+    }
+    assert!(setup.camera.is_none());
+}
