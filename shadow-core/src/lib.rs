@@ -12,7 +12,9 @@
 //!   G-buffers now, shadow maps and depth peeling for the SSM family) and the shared view samples.
 //! * [`visibility`] and [`technique`]: visibility buffers and the object-safe
 //!   [`ShadowTechnique`] trait with its [`Stats`] and [`TechniqueError`].
+//! * [`direct`]: direct illumination from per-sample visibility (DCS eq. 6).
 //! * [`metrics`]: RMSE, penumbra RMSE, bias, max error, share over 0.1, per-sample agreement.
+//! * [`preset`]: named technique configurations with their error budgets.
 //! * [`load`], [`scenes`] and [`procedural`]: glTF and OBJ loading, built-in scenes.
 //! * [`image_io`]: EXR and PNG output.
 //!
@@ -36,11 +38,13 @@
 #![deny(missing_docs)]
 
 pub mod camera;
+pub mod direct;
 pub mod geometry;
 pub mod image_io;
 pub mod light;
 pub mod load;
 pub mod metrics;
+pub mod preset;
 pub mod procedural;
 pub mod raster;
 pub mod sampling;
@@ -67,6 +71,7 @@ pub mod prelude {
     };
     pub use crate::load::SceneSetup;
     pub use crate::metrics::{Metrics, compare};
+    pub use crate::preset::{Budget, Preset};
     pub use crate::sampling::{LightSampler, SamplingStrategy};
     pub use crate::scene::{MeshDesc, Scene, SceneBuilder, TriangleScene};
     pub use crate::technique::{

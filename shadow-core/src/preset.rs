@@ -1,0 +1,67 @@
+//! Technique presets: a name, a constructor and the error budgets a technique declares per
+//! scene. Each technique crate exposes `presets() -> Vec<Preset>`; the conformance suite and
+//! xtask iterate the union, so adding a preset needs no new code anywhere else.
+
+use serde::Serialize;
+
+use crate::technique::ShadowTechnique;
+
+/// Largest errors a preset promises on one scene, against the reference on the same view
+/// samples (DESIGN section 6). A tighter measured value is good news, a looser one a failure.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Budget {
+    /// Root mean square error.
+    pub rmse: f64,
+    /// RMSE over penumbra pixels.
+    pub penumbra_rmse: f64,
+    /// Absolute mean signed error.
+    pub bias: f64,
+    /// Largest absolute error.
+    pub max_abs: f64,
+    /// Share of pixels off by more than 0.1.
+    pub share_over_0_1: f64,
+    /// Share of pixels the reference calls fully lit that the technique darkens by more than
+    /// 0.1 (false shadow).
+    pub false_shadow: f64,
+    /// Least per-sample agreement with the same-samples reference (sample-based techniques).
+    pub min_sample_agreement: Option<f64>,
+}
+
+impl Budget {
+    /// A budget with the same bound on RMSE-like terms and no per-sample requirement.
+    pub const fn uniform(rmse: f64, max_abs: f64, share: f64) -> Self {
+        Self {
+            rmse,
+            penumbra_rmse: rmse * 2.0,
+            bias: rmse,
+            max_abs,
+            share_over_0_1: share,
+            false_shadow: share,
+            min_sample_agreement: None,
+        }
+    }
+}
+
+/// A named, constructible technique configuration with its budgets.
+#[derive(Clone, Copy)]
+pub struct Preset {
+    /// Unique name, e.g. `ref-64` or `dcs-64`.
+    pub name: &'static str,
+    /// One line for listings.
+    pub description: &'static str,
+    /// Builds a fresh technique with the preset's parameters and `seed`.
+    pub make: fn(seed: u64) -> Box<dyn ShadowTechnique>,
+    /// The budget for a built-in scene, or `None` when the preset makes no promise there.
+    pub budget: fn(scene: &str) -> Option<Budget>,
+    /// For sample-based presets: the same technique with another sample count, used by the
+    /// convergence check (error must fall as samples grow).
+    pub with_samples: Option<fn(samples: u32, seed: u64) -> Box<dyn ShadowTechnique>>,
+}
+
+impl std::fmt::Debug for Preset {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Preset")
+            .field("name", &self.name)
+            .finish_non_exhaustive()
+    }
+}

@@ -1,0 +1,437 @@
+//! The ray-traced reference as a [`ShadowTechnique`] (`ref`): for every view sample, the light
+//! samples of a [`LightSampler`] are tested for occlusion with the BVH and the visibility
+//! coefficient `V(p)` (DCS eq. 1), its RGB form for textured lights (DCS eq. 2) and, on request,
+//! the direct illumination (DCS eq. 6 estimator of eq. 4) are accumulated.
+//!
+//! Modes:
+//! * stratified: `N` jittered stratified samples per pixel (default 1024);
+//! * same samples: exactly the sampler another technique declares, with per-sample visibility;
+//! * semi-opaque occluders: the product of the transmittances of every surface a segment crosses
+//!   (the physically right answer DCS's saturating sum approximates);
+//! * hard: one sample at the light centre (the point-light limit).
+//!
+//! A sample below the receiver's tangent plane (camera-facing geometric normal) is occluded
+//! without a ray; the receiver's own triangle is never an occluder of its samples (it cannot be:
+//! the sample is above its plane), which keeps the origin offset small. Pixels are independent and their samples come from a counter-based hash, so
+//! the output is identical whatever the thread count.
+
+use std::sync::Arc;
+
+use glam::{UVec2, Vec2, Vec3};
+use rayon::prelude::*;
+use serde_json::json;
+use shadow_core::direct::pixel_direct;
+use shadow_core::light::{LightKind, LightSample, PointLight};
+use shadow_core::prelude::*;
+use shadow_core::sampling::SamplingError;
+
+use crate::bvh::OcclusionBvh;
+use crate::offset::RayOffset;
+
+/// Where the reference takes its light samples from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SampleSource {
+    /// A stratified sampler of its own.
+    Stratified,
+    /// Exactly another technique's samples.
+    Same,
+    /// One sample at the light centre (hard shadow).
+    Hard,
+}
+
+struct Prepared {
+    scene: SceneRef,
+    light: Light,
+    bvh: OcclusionBvh,
+    offset: RayOffset,
+}
+
+/// The ray-traced reference.
+pub struct Reference {
+    name: String,
+    source: SampleSource,
+    sampler: LightSampler,
+    per_sample: bool,
+    prepared: Option<Prepared>,
+}
+
+impl std::fmt::Debug for Reference {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Reference")
+            .field("name", &self.name)
+            .field("source", &self.source)
+            .field("samples", &self.sampler.count())
+            .finish()
+    }
+}
+
+/// Outgoing radiance per pixel under diffuse shading (DCS eq. 6), background black.
+pub type DirectImage = Vec<Vec3>;
+
+impl Reference {
+    /// `samples` stratified samples per pixel with `seed`.
+    ///
+    /// # Errors
+    /// [`SamplingError`] for a sample count outside the sampler's range.
+    pub fn stratified(samples: u32, seed: u64) -> Result<Self, SamplingError> {
+        Ok(Self {
+            name: if samples == 1024 {
+                "ref".into()
+            } else {
+                format!("ref-{samples}")
+            },
+            source: SampleSource::Stratified,
+            sampler: LightSampler::new(SamplingStrategy::Stratified, samples, seed)?,
+            per_sample: false,
+            prepared: None,
+        })
+    }
+
+    /// Exactly the samples of `sampler`, with per-sample visibility in the output.
+    pub fn same_samples(sampler: LightSampler) -> Self {
+        Self {
+            name: "ref-same-samples".into(),
+            source: SampleSource::Same,
+            sampler,
+            per_sample: true,
+            prepared: None,
+        }
+    }
+
+    /// The hard shadow of the light's centre (point-light limit).
+    pub fn hard() -> Self {
+        Self {
+            name: "ref-hard".into(),
+            source: SampleSource::Hard,
+            sampler: LightSampler::new(SamplingStrategy::Correlated, 1, 0)
+                .expect("one sample is valid"),
+            per_sample: true,
+            prepared: None,
+        }
+    }
+
+    /// Also return per-sample visibility (bits: 1 = no surface crossed).
+    #[must_use]
+    pub fn with_per_sample(mut self, on: bool) -> Self {
+        self.per_sample = on;
+        self
+    }
+
+    /// Renames the instance (presets).
+    #[must_use]
+    pub fn named(mut self, name: &str) -> Self {
+        self.name = name.into();
+        self
+    }
+
+    /// The BVH, once prepared.
+    pub fn bvh(&self) -> Option<&OcclusionBvh> {
+        self.prepared.as_ref().map(|p| &p.bvh)
+    }
+
+    fn prepared(&self) -> Result<&Prepared, TechniqueError> {
+        self.prepared
+            .as_ref()
+            .ok_or_else(|| TechniqueError::NotPrepared(self.name.clone()))
+    }
+
+    /// The light samples of a pixel (the centre alone in hard mode).
+    fn pixel_samples(
+        &self,
+        light: &dyn AreaLight,
+        pixel: UVec2,
+        units: &mut Vec<Vec2>,
+        out: &mut Vec<LightSample>,
+    ) {
+        out.clear();
+        if self.source == SampleSource::Hard {
+            let c = light.center();
+            out.push(LightSample {
+                position: c,
+                normal: Vec3::ZERO,
+                uv: Vec2::splat(0.5),
+                radiance: light.radiance().mean(),
+            });
+            return;
+        }
+        self.sampler.unit_samples(pixel, units);
+        out.extend(units.iter().map(|u| light.sample(*u)));
+    }
+
+    /// The occlusion segment from view sample `s` to light point `y`: robust origin, unit
+    /// direction and length, or `None` when `y` is below the receiver's tangent plane.
+    ///
+    /// # Errors
+    /// [`TechniqueError::NotPrepared`] before `prepare`.
+    pub fn segment(
+        &self,
+        s: &ViewSample,
+        y: Vec3,
+    ) -> Result<Option<(Vec3, Vec3, f32)>, TechniqueError> {
+        Ok(segment(self.prepared()?, s, y))
+    }
+
+    /// Visibility of each light sample from view sample `s` (transmittance in [0, 1]), and the
+    /// number of rays cast.
+    fn sample_visibility(
+        &self,
+        p: &Prepared,
+        s: &ViewSample,
+        samples: &[LightSample],
+        vis: &mut Vec<f32>,
+    ) -> u64 {
+        vis.clear();
+        let semi = p.scene.has_semi_opaque();
+        let mut rays = 0;
+        for y in samples {
+            let Some((origin, dir, t_max)) = segment(p, s, y.position) else {
+                vis.push(0.0);
+                continue;
+            };
+            rays += 1;
+            vis.push(if semi {
+                p.bvh.transmittance(origin, dir, t_max, s.triangle).0
+            } else if p.bvh.occluded(origin, dir, t_max, s.triangle) {
+                0.0
+            } else {
+                1.0
+            });
+        }
+        rays
+    }
+
+    /// Direct illumination of every view sample (DCS eq. 6 with the exact transmittance).
+    ///
+    /// # Errors
+    /// [`TechniqueError::NotPrepared`] before `prepare`.
+    pub fn direct_illumination(&self, view: &ViewSamples) -> Result<DirectImage, TechniqueError> {
+        let p = self.prepared()?;
+        let w = view.width() as usize;
+        let mut out = vec![Vec3::ZERO; view.len()];
+        out.par_chunks_mut(w).enumerate().for_each(|(row, line)| {
+            let (mut units, mut samples, mut vis) = (Vec::new(), Vec::new(), Vec::new());
+            for (x, px) in line.iter_mut().enumerate() {
+                let Some(s) = view.get(row * w + x) else {
+                    continue;
+                };
+                self.pixel_samples(p.light.as_ref(), s.pixel, &mut units, &mut samples);
+                self.sample_visibility(p, &s, &samples, &mut vis);
+                let albedo = p.scene.albedo(s.triangle as usize);
+                let light: &dyn AreaLight = if self.source == SampleSource::Hard {
+                    &HardLight(p.light.center())
+                } else {
+                    p.light.as_ref()
+                };
+                *px = pixel_direct(&s, albedo, light, &samples, |k| vis[k]);
+            }
+        });
+        Ok(out)
+    }
+}
+
+fn segment(p: &Prepared, s: &ViewSample, y: Vec3) -> Option<(Vec3, Vec3, f32)> {
+    if (y - s.position).dot(s.geometric_normal) <= 0.0 {
+        return None;
+    }
+    let origin = p.offset.offset(s.position, s.geometric_normal);
+    let d = y - origin;
+    if d.dot(s.geometric_normal) <= 0.0 {
+        return None;
+    }
+    let dist = d.length();
+    Some((origin, d / dist, dist * (1.0 - 1e-6)))
+}
+
+/// The light's centre as a point light, for hard-mode direct illumination.
+#[derive(Debug)]
+struct HardLight(Vec3);
+
+impl AreaLight for HardLight {
+    fn geometry(&self) -> shadow_core::light::LightGeometry<'_> {
+        shadow_core::light::LightGeometry::Point { position: self.0 }
+    }
+    fn area(&self) -> f32 {
+        0.0
+    }
+    fn center(&self) -> Vec3 {
+        self.0
+    }
+    fn bounds(&self) -> shadow_core::geometry::Aabb {
+        shadow_core::geometry::Aabb::from_points(&[self.0])
+    }
+    fn point_at(&self, u: Vec2) -> (Vec3, Vec3, Vec2) {
+        (self.0, Vec3::ZERO, u)
+    }
+    fn radiance(&self) -> &Radiance {
+        static ONE: Radiance = Radiance::Constant(Vec3::ONE);
+        &ONE
+    }
+}
+
+use shadow_core::view_samples::ViewSample;
+
+impl ShadowTechnique for Reference {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn capabilities(&self) -> Capabilities {
+        Capabilities {
+            lights: vec![
+                LightKind::Rectangle,
+                LightKind::Disk,
+                LightKind::Polygon,
+                LightKind::Sphere,
+                LightKind::Point,
+            ],
+            semi_opaque: true,
+            textured_lights: true,
+            needs_closed_meshes: false,
+            sample_based: self.source != SampleSource::Stratified,
+            processor: Processor::Cpu,
+        }
+    }
+
+    fn parameters(&self) -> serde_json::Value {
+        json!({
+            "mode": format!("{:?}", self.source),
+            "samples": if self.source == SampleSource::Hard { 1 } else { self.sampler.count() },
+            "strategy": format!("{:?}", self.sampler.strategy()),
+            "seed": self.sampler.seed(),
+            "per_sample": self.per_sample,
+        })
+    }
+
+    fn light_sampler(&self) -> Option<&LightSampler> {
+        (self.source != SampleSource::Hard).then_some(&self.sampler)
+    }
+
+    fn prepare(&mut self, scene: SceneRef, light: Light) -> Result<Stats, TechniqueError> {
+        let mut stats = Stats::default();
+        let bvh = stats.time("bvh-build", || OcclusionBvh::build(scene.as_ref()));
+        stats.add("triangles", scene.triangle_count() as u64);
+        let extent = scene.bounds().union(light.bounds()).diagonal();
+        let light: Light = if light.area() == 0.0 {
+            Arc::new(
+                PointLight::new(light.center(), light.radiance().clone())
+                    .map_err(|e| TechniqueError::InvalidInput(e.to_string()))?,
+            )
+        } else {
+            light
+        };
+        self.prepared = Some(Prepared {
+            scene,
+            light,
+            bvh,
+            offset: RayOffset::for_extent(extent),
+        });
+        Ok(stats)
+    }
+
+    fn estimate(&mut self, view: &ViewSamples) -> Result<Estimate, TechniqueError> {
+        let p = self.prepared()?;
+        let mut stats = Stats::default();
+        let textured = p.light.is_textured() && self.source != SampleSource::Hard;
+        let n = if self.source == SampleSource::Hard {
+            1
+        } else {
+            self.sampler.count()
+        };
+        let w = view.width() as usize;
+        let words = n.div_ceil(64) as usize;
+        struct Row {
+            v: Vec<f32>,
+            rgb: Vec<Vec3>,
+            class: Vec<PixelClass>,
+            bits: Vec<u64>,
+            rays: u64,
+            below: u64,
+        }
+        let rows: Vec<Row> = stats.time("trace", || {
+            (0..view.height() as usize)
+                .into_par_iter()
+                .map(|row| {
+                    let mut r = Row {
+                        v: vec![0.0; w],
+                        rgb: vec![Vec3::ZERO; if textured { w } else { 0 }],
+                        class: vec![PixelClass::Background; w],
+                        bits: vec![0; if self.per_sample { w * words } else { 0 }],
+                        rays: 0,
+                        below: 0,
+                    };
+                    let (mut units, mut samples, mut vis) = (Vec::new(), Vec::new(), Vec::new());
+                    for x in 0..w {
+                        let Some(s) = view.get(row * w + x) else {
+                            continue;
+                        };
+                        self.pixel_samples(p.light.as_ref(), s.pixel, &mut units, &mut samples);
+                        let rays = self.sample_visibility(p, &s, &samples, &mut vis);
+                        r.rays += rays;
+                        r.below += samples.len() as u64 - rays;
+                        let sum: f64 = vis.iter().map(|&v| v as f64).sum();
+                        r.v[x] = (sum / n as f64) as f32;
+                        if textured {
+                            let acc = samples
+                                .iter()
+                                .zip(&vis)
+                                .fold(Vec3::ZERO, |a, (s, v)| a + s.radiance * *v);
+                            r.rgb[x] = acc / n as f32;
+                        }
+                        let lit = vis.iter().filter(|&&v| v == 1.0).count();
+                        r.class[x] = if lit == vis.len() {
+                            PixelClass::Lit
+                        } else if vis.iter().all(|&v| v == 0.0) {
+                            PixelClass::Umbra
+                        } else {
+                            PixelClass::Penumbra
+                        };
+                        if self.per_sample {
+                            for (k, &v) in vis.iter().enumerate() {
+                                if v == 1.0 {
+                                    r.bits[x * words + k / 64] |= 1 << (k % 64);
+                                }
+                            }
+                        }
+                    }
+                    r
+                })
+                .collect()
+        });
+        let mut vis = if textured {
+            VisibilityImage::rgb_buffer(view)
+        } else {
+            VisibilityImage::scalar(view)
+        };
+        let mut classes = Vec::with_capacity(view.len());
+        let mut bits = Vec::with_capacity(if self.per_sample {
+            view.len() * words
+        } else {
+            0
+        });
+        for (row, r) in rows.iter().enumerate() {
+            if textured {
+                vis.rgbs_mut()[row * w..(row + 1) * w].copy_from_slice(&r.rgb);
+            } else {
+                vis.scalars_mut()[row * w..(row + 1) * w].copy_from_slice(&r.v);
+            }
+            classes.extend_from_slice(&r.class);
+            bits.extend_from_slice(&r.bits);
+            stats.add("occlusion-rays", r.rays);
+            stats.add("samples-below-horizon", r.below);
+        }
+        stats.add("pixels", view.valid_count() as u64);
+        stats.add("threads", rayon::current_num_threads() as u64);
+        vis.set_classes(classes)?;
+        if self.per_sample {
+            vis.set_per_sample(PerSampleVisibility::Bits {
+                samples: n,
+                words: bits,
+            })?;
+        }
+        vis.validate()?;
+        Ok(Estimate {
+            visibility: vis,
+            stats,
+        })
+    }
+}
