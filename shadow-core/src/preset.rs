@@ -28,6 +28,32 @@ pub struct Budget {
 }
 
 impl Budget {
+    /// A budget from errors measured by the conformance suite (`rmse`, `penumbra_rmse`, `bias`,
+    /// `max_abs`, `share_over_0_1`), with the suite's documented margins: 25% on RMSE, penumbra
+    /// RMSE and max error (max capped at 1), |bias| doubled with a floor of 0.002, the share
+    /// over 0.1 plus 25% and 0.002, and false shadow at most 0.2% of pixels. Measurements are
+    /// deterministic for a seed, so the margins only absorb platform differences in `libm`.
+    pub fn from_measured(m: [f64; 5]) -> Self {
+        let [rmse, pen, bias, max, share] = m;
+        Self {
+            rmse: rmse * 1.25,
+            penumbra_rmse: pen * 1.25,
+            bias: (bias.abs() * 2.0).max(0.002),
+            max_abs: (max * 1.25).min(1.0),
+            share_over_0_1: share * 1.25 + 0.002,
+            false_shadow: 0.002,
+            min_sample_agreement: None,
+        }
+    }
+
+    /// Looks `scene` up in a table of measured errors (see [`Budget::from_measured`]).
+    pub fn lookup(table: &[(&str, [f64; 5])], scene: &str) -> Option<Self> {
+        table
+            .iter()
+            .find(|(s, _)| *s == scene)
+            .map(|(_, m)| Self::from_measured(*m))
+    }
+
     /// A budget with the same bound on RMSE-like terms and no per-sample requirement.
     pub const fn uniform(rmse: f64, max_abs: f64, share: f64) -> Self {
         Self {

@@ -331,7 +331,7 @@ impl ShadowTechnique for Reference {
     fn estimate(&mut self, view: &ViewSamples) -> Result<Estimate, TechniqueError> {
         let p = self.prepared()?;
         let mut stats = Stats::default();
-        let textured = p.light.is_textured() && self.source != SampleSource::Hard;
+        let textured = p.light.is_textured();
         let n = if self.source == SampleSource::Hard {
             1
         } else {

@@ -1,1 +1,39 @@
-//! conformance
+//! # shadow-tests: the conformance suite
+//!
+//! One set of checks, run against every registered technique preset on every built-in scene
+//! its capabilities support (DESIGN section 6): values in [0, 1], no NaN, no false shadow where
+//! the reference is fully lit, error within the preset's declared budgets, determinism for a
+//! seed, and error falling as samples grow. Each comparison uses the same view samples as the
+//! reference, and the same light samples when the technique is sample-based.
+//!
+//! The registry is the union of the technique crates' `presets()`: adding a preset there adds it
+//! here and to `cargo xtask conformance`, with no new code.
+
+#![deny(missing_docs)]
+
+pub mod closed_form;
+pub mod conformance;
+pub mod stress;
+
+use shadow_core::preset::Preset;
+
+/// Every registered preset, from every technique crate.
+pub fn registry() -> Vec<Preset> {
+    let mut all = Vec::new();
+    all.extend(shadow_ref::presets());
+    all
+}
+
+/// The preset called `name`.
+///
+/// # Errors
+/// A message listing the valid names.
+pub fn preset(name: &str) -> Result<Preset, String> {
+    let all = registry();
+    all.iter().find(|p| p.name == name).copied().ok_or_else(|| {
+        format!(
+            "unknown technique `{name}`; valid names: {}",
+            all.iter().map(|p| p.name).collect::<Vec<_>>().join(", ")
+        )
+    })
+}

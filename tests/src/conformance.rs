@@ -1,0 +1,399 @@
+//! The conformance runner: one preset on one scene, against the reference on the same view
+//! samples, with every check of DESIGN section 6.
+
+use std::sync::OnceLock;
+use std::time::Instant;
+
+use serde::Serialize;
+use shadow_core::metrics::{Metrics, compare};
+use shadow_core::prelude::*;
+use shadow_core::preset::{Budget, Preset};
+use shadow_ref::Reference;
+
+/// Image size, reference sample count and seed of a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct SuiteConfig {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Samples per pixel of the stratified reference.
+    pub ref_samples: u32,
+    /// Seed of every technique.
+    pub seed: u64,
+    /// Check determinism and convergence (two and three extra runs per case).
+    pub extra_checks: bool,
+}
+
+impl Default for SuiteConfig {
+    fn default() -> Self {
+        Self {
+            width: 64,
+            height: 48,
+            ref_samples: 1024,
+            seed: 1,
+            extra_checks: true,
+        }
+    }
+}
+
+/// A scene prepared once for every preset: the setup, its view samples and (lazily) the
+/// stratified reference.
+pub struct SceneContext {
+    /// The scene.
+    pub setup: SceneSetup,
+    /// Shared view samples.
+    pub view: ViewSamples,
+    config: SuiteConfig,
+    reference: OnceLock<Result<(VisibilityImage, f64), String>>,
+}
+
+impl SceneContext {
+    /// Renders the view samples of `setup`.
+    ///
+    /// # Errors
+    /// A message when the scene has no light or the view cannot be rendered.
+    pub fn new(setup: SceneSetup, config: SuiteConfig) -> Result<Self, String> {
+        if setup.lights.is_empty() {
+            return Err(format!("scene `{}` has no light", setup.name));
+        }
+        let camera = setup.camera_or_default();
+        let view = ViewSamples::render(setup.scene.as_ref(), &camera, config.width, config.height)
+            .map_err(|e| e.to_string())?;
+        Ok(Self {
+            setup,
+            view,
+            config,
+            reference: OnceLock::new(),
+        })
+    }
+
+    /// The light every case uses (the scene's first).
+    pub fn light(&self) -> Light {
+        self.setup.lights[0].clone()
+    }
+
+    /// The stratified reference and its time in seconds.
+    ///
+    /// # Errors
+    /// The reference's error as text.
+    pub fn reference(&self) -> Result<&(VisibilityImage, f64), String> {
+        self.reference
+            .get_or_init(|| {
+                let seed = self.config.seed ^ 0x5eed_0f_7e5e;
+                let mut r = Reference::stratified(self.config.ref_samples, seed)
+                    .map_err(|e| e.to_string())?;
+                run_technique(&mut r, &self.setup, self.light(), &self.view)
+                    .map(|(e, _, secs)| (e.visibility, secs))
+                    .map_err(|e| e.to_string())
+            })
+            .as_ref()
+            .map_err(Clone::clone)
+    }
+}
+
+/// Prepares and runs a technique; returns the estimate, the prepare stats and the wall time of
+/// prepare plus estimate.
+///
+/// # Errors
+/// The technique's error.
+pub fn run_technique(
+    tech: &mut dyn ShadowTechnique,
+    setup: &SceneSetup,
+    light: Light,
+    view: &ViewSamples,
+) -> Result<(Estimate, Stats, f64), TechniqueError> {
+    let t0 = Instant::now();
+    let prep = tech.prepare(setup.scene.clone(), light)?;
+    let est = tech.estimate(view)?;
+    Ok((est, prep, t0.elapsed().as_secs_f64()))
+}
+
+/// What happened to one (preset, scene) case.
+#[derive(Debug)]
+pub enum Outcome {
+    /// The preset does not support the scene; the reason says why.
+    Unsupported {
+        /// Why.
+        reason: String,
+    },
+    /// The technique failed with an error (a conformance failure).
+    Failed {
+        /// The error.
+        error: String,
+    },
+    /// It ran; the report holds the measurements and any violations.
+    Ran(Box<CaseReport>),
+}
+
+/// Measurements and verdicts of one case.
+#[derive(Debug, Serialize)]
+pub struct CaseReport {
+    /// Preset name.
+    pub technique: String,
+    /// Scene name.
+    pub scene: String,
+    /// Errors against the reference.
+    pub metrics: Metrics,
+    /// Share of reference-lit pixels the technique darkened by more than 0.1.
+    pub false_shadow: f64,
+    /// The declared budget, if any.
+    pub budget: Option<Budget>,
+    /// Every check that failed, in words.
+    pub violations: Vec<String>,
+    /// Same seed, same output (`None` when not checked).
+    pub deterministic: Option<bool>,
+    /// RMSE at 16 and at 256 samples (sample-count presets).
+    pub convergence: Option<(f64, f64)>,
+    /// Technique parameters.
+    pub parameters: serde_json::Value,
+    /// Prepare statistics.
+    pub prepare_stats: Stats,
+    /// Estimate statistics.
+    pub estimate_stats: Stats,
+    /// Prepare + estimate wall time, seconds.
+    pub seconds: f64,
+    /// Wall time of the reference it was compared with, seconds.
+    pub reference_seconds: f64,
+    /// True when compared with the same-samples reference.
+    pub same_samples: bool,
+    /// The technique's output.
+    #[serde(skip)]
+    pub estimate: VisibilityImage,
+    /// The reference it was compared with.
+    #[serde(skip)]
+    pub reference: VisibilityImage,
+}
+
+impl CaseReport {
+    /// True when every check held.
+    pub fn passed(&self) -> bool {
+        self.violations.is_empty()
+    }
+}
+
+/// Share of pixels the reference calls fully lit where `estimate` is darker by more than 0.1.
+pub fn false_shadow_share(
+    estimate: &dyn VisibilityBuffer,
+    reference: &dyn VisibilityBuffer,
+) -> f64 {
+    let (mut n, mut bad) = (0u64, 0u64);
+    for i in 0..reference.len() {
+        if !reference.is_valid(i) {
+            continue;
+        }
+        n += 1;
+        let lit = match reference.class(i) {
+            Some(c) => c == PixelClass::Lit,
+            None => reference.value(i) >= 1.0,
+        };
+        if lit && estimate.value(i) < reference.value(i) - 0.1 {
+            bad += 1;
+        }
+    }
+    if n == 0 { 0.0 } else { bad as f64 / n as f64 }
+}
+
+fn check_budget(m: &Metrics, false_shadow: f64, b: &Budget, v: &mut Vec<String>) {
+    let mut over = |what: &str, got: f64, limit: f64| {
+        if got > limit || got.is_nan() {
+            v.push(format!("{what} {got:.5} exceeds budget {limit:.5}"));
+        }
+    };
+    over("rmse", m.rmse, b.rmse);
+    if let Some(p) = m.penumbra_rmse {
+        over("penumbra rmse", p, b.penumbra_rmse);
+    }
+    over("|bias|", m.bias.abs(), b.bias);
+    over("max error", m.max_abs, b.max_abs);
+    over("share > 0.1", m.share_over_0_1, b.share_over_0_1);
+    over("false shadow", false_shadow, b.false_shadow);
+    if let Some(min) = b.min_sample_agreement {
+        match m.sample_agreement {
+            Some(a) if a >= min => {}
+            Some(a) => v.push(format!("per-sample agreement {a:.6} below {min:.6}")),
+            None => v.push("no per-sample visibility to compare".into()),
+        }
+    }
+}
+
+/// Runs every check for `preset` on the scene of `ctx`.
+pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
+    let cfg = ctx.config;
+    let mut tech = (preset.make)(cfg.seed);
+    let caps = tech.capabilities();
+    if let Err(reason) = caps.check(ctx.setup.scene.as_ref(), ctx.light().as_ref()) {
+        return Outcome::Unsupported { reason };
+    }
+    let (est, prep, seconds) =
+        match run_technique(tech.as_mut(), &ctx.setup, ctx.light(), &ctx.view) {
+            Ok(r) => r,
+            Err(TechniqueError::Unsupported { reason, .. }) => {
+                return Outcome::Unsupported { reason };
+            }
+            Err(e) => {
+                return Outcome::Failed {
+                    error: e.to_string(),
+                };
+            }
+        };
+    let mut violations = Vec::new();
+    if let Err(e) = est.visibility.validate() {
+        violations.push(format!("invalid output: {e}"));
+    }
+    let same = caps.sample_based && tech.light_sampler().is_some();
+    let (reference, reference_seconds) = if same {
+        let sampler = tech.light_sampler().expect("checked above").clone();
+        let mut r = Reference::same_samples(sampler);
+        match run_technique(&mut r, &ctx.setup, ctx.light(), &ctx.view) {
+            Ok((e, _, s)) => (e.visibility, s),
+            Err(e) => {
+                return Outcome::Failed {
+                    error: format!("reference: {e}"),
+                };
+            }
+        }
+    } else {
+        match ctx.reference() {
+            Ok((r, s)) => (r.clone(), *s),
+            Err(e) => {
+                return Outcome::Failed {
+                    error: format!("reference: {e}"),
+                };
+            }
+        }
+    };
+    let metrics = match compare(&est.visibility, &reference) {
+        Ok(m) => m,
+        Err(e) => {
+            return Outcome::Failed {
+                error: format!("metrics: {e}"),
+            };
+        }
+    };
+    let false_shadow = false_shadow_share(&est.visibility, &reference);
+    let budget = (preset.budget)(&ctx.setup.name);
+    match &budget {
+        Some(b) => check_budget(&metrics, false_shadow, b, &mut violations),
+        None => violations.push("the preset declares no budget for this scene".into()),
+    }
+    let mut deterministic = None;
+    let mut convergence = None;
+    if cfg.extra_checks {
+        let mut again = (preset.make)(cfg.seed);
+        match run_technique(again.as_mut(), &ctx.setup, ctx.light(), &ctx.view) {
+            Ok((e2, _, _)) => {
+                let same_output = e2.visibility.coefficients() == est.visibility.coefficients();
+                if !same_output {
+                    violations
+                        .push("not deterministic: a second run with the same seed differs".into());
+                }
+                deterministic = Some(same_output);
+            }
+            Err(e) => violations.push(format!("second run failed: {e}")),
+        }
+        if let Some(with) = preset.with_samples {
+            let rmse_at = |n: u32| -> Result<f64, String> {
+                let mut t = with(n, cfg.seed);
+                let (e, _, _) = run_technique(t.as_mut(), &ctx.setup, ctx.light(), &ctx.view)
+                    .map_err(|e| e.to_string())?;
+                let r = if t.capabilities().sample_based {
+                    let mut r = Reference::stratified(cfg.ref_samples, cfg.seed ^ 0x5eed_0f_7e5e)
+                        .map_err(|e| e.to_string())?;
+                    run_technique(&mut r, &ctx.setup, ctx.light(), &ctx.view)
+                        .map_err(|e| e.to_string())?
+                        .0
+                        .visibility
+                } else {
+                    ctx.reference()?.0.clone()
+                };
+                compare(&e.visibility, &r)
+                    .map(|m| m.rmse)
+                    .map_err(|e| e.to_string())
+            };
+            match (rmse_at(16), rmse_at(256)) {
+                (Ok(a), Ok(b)) => {
+                    if !(b < a) && a > 1e-6 {
+                        violations.push(format!(
+                            "error does not fall with samples: rmse {a:.5} at 16, {b:.5} at 256"
+                        ));
+                    }
+                    convergence = Some((a, b));
+                }
+                (Err(e), _) | (_, Err(e)) => {
+                    violations.push(format!("convergence run failed: {e}"))
+                }
+            }
+        }
+    }
+    Outcome::Ran(Box::new(CaseReport {
+        technique: preset.name.to_string(),
+        scene: ctx.setup.name.clone(),
+        metrics,
+        false_shadow,
+        budget,
+        violations,
+        deterministic,
+        convergence,
+        parameters: tech.parameters(),
+        prepare_stats: prep,
+        estimate_stats: est.stats,
+        seconds,
+        reference_seconds,
+        same_samples: same,
+        estimate: est.visibility,
+        reference,
+    }))
+}
+
+/// One point of the reference's time-error curve.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct CurvePoint {
+    /// Samples per pixel.
+    pub samples: u32,
+    /// RMSE against the high-count reference.
+    pub rmse: f64,
+    /// Seconds (prepare + estimate).
+    pub seconds: f64,
+}
+
+/// The reference at each of `counts` samples against the context's reference: the baseline
+/// time-error curve.
+///
+/// # Errors
+/// A message when a run fails.
+pub fn reference_curve(ctx: &SceneContext, counts: &[u32]) -> Result<Vec<CurvePoint>, String> {
+    let (high, _) = ctx.reference()?;
+    counts
+        .iter()
+        .map(|&n| {
+            let mut r =
+                Reference::stratified(n, ctx.config.seed ^ 0xc0ffee).map_err(|e| e.to_string())?;
+            let (e, _, secs) = run_technique(&mut r, &ctx.setup, ctx.light(), &ctx.view)
+                .map_err(|e| e.to_string())?;
+            let m = compare(&e.visibility, high).map_err(|e| e.to_string())?;
+            Ok(CurvePoint {
+                samples: n,
+                rmse: m.rmse,
+                seconds: secs,
+            })
+        })
+        .collect()
+}
+
+/// The reference's time at error `rmse`, interpolated log-log on `curve` (sorted by samples).
+/// `None` when `rmse` is below the curve's best error (the technique beats every reference run).
+pub fn reference_time_at(curve: &[CurvePoint], rmse: f64) -> Option<f64> {
+    let first = curve.first()?;
+    if rmse >= first.rmse {
+        return Some(first.seconds);
+    }
+    for w in curve.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if rmse <= a.rmse && rmse >= b.rmse && a.rmse > 0.0 && b.rmse > 0.0 {
+            let t = (rmse.ln() - a.rmse.ln()) / (b.rmse.ln() - a.rmse.ln());
+            return Some((a.seconds.ln() + t * (b.seconds.ln() - a.seconds.ln())).exp());
+        }
+    }
+    None
+}

@@ -1,0 +1,375 @@
+//! The numerical-stability suite (DESIGN section 6): scale and translation invariance, slivers
+//! and zero-area triangles, coplanar and touching geometry, grazing light, a tiny light tending
+//! to the hard shadow, a light larger than the scene, NaN/Inf input and malformed files, run
+//! against every registered technique. `cargo xtask stress` prints the table; `cargo test` runs
+//! the same cases at a small size.
+
+use std::sync::Arc;
+
+use glam::{Affine3A, Vec3};
+use serde::Serialize;
+use shadow_core::load::{LoadLimits, load_gltf_slice, load_obj_slice};
+use shadow_core::metrics::compare;
+use shadow_core::prelude::*;
+use shadow_core::preset::Preset;
+use shadow_core::procedural::{cuboid, floor, quad};
+use shadow_core::scene::SceneError;
+use shadow_core::scenes::{builtin, transformed};
+use shadow_ref::Reference;
+
+use crate::conformance::run_technique;
+
+/// One stress verdict.
+#[derive(Debug, Clone, Serialize)]
+pub struct StressResult {
+    /// Case name.
+    pub case: String,
+    /// Preset name (`-` for input-validation cases).
+    pub technique: String,
+    /// True when the property held.
+    pub held: bool,
+    /// What was measured.
+    pub detail: String,
+}
+
+fn result(case: &str, technique: &str, held: bool, detail: String) -> StressResult {
+    StressResult {
+        case: case.into(),
+        technique: technique.into(),
+        held,
+        detail,
+    }
+}
+
+/// Input-validation cases: every bad input is a typed error.
+pub fn input_cases() -> Vec<StressResult> {
+    let mut out = Vec::new();
+    let tri = |p: Vec3| vec![Vec3::ZERO, Vec3::X, p];
+    let mut expect = |case: &str, ok: bool, detail: String| out.push(result(case, "-", ok, detail));
+    let r = TriangleScene::new(tri(Vec3::new(f32::NAN, 1.0, 0.0)), vec![[0, 1, 2]]);
+    expect(
+        "nan-vertex",
+        matches!(r, Err(SceneError::NonFiniteVertex { .. })),
+        format!("{:?}", r.err()),
+    );
+    let r = TriangleScene::new(tri(Vec3::new(0.0, f32::INFINITY, 0.0)), vec![[0, 1, 2]]);
+    expect(
+        "inf-vertex",
+        matches!(r, Err(SceneError::NonFiniteVertex { .. })),
+        format!("{:?}", r.err()),
+    );
+    let r = TriangleScene::new(tri(Vec3::new(2.0, 0.0, 0.0)), vec![[0, 1, 2]]);
+    expect(
+        "zero-area-triangle",
+        matches!(r, Err(SceneError::DegenerateTriangle { .. })),
+        format!("{:?}", r.err()),
+    );
+    let r = RectLight::facing(Vec3::NAN, Vec3::Y, 1.0, 1.0, Radiance::Constant(Vec3::ONE));
+    expect("nan-light", r.is_err(), format!("{:?}", r.err()));
+    let r = Camera::look_at(Vec3::new(0.0, f32::NAN, 1.0), Vec3::ZERO, Vec3::Y, 1.0);
+    expect("nan-camera", r.is_err(), format!("{:?}", r.err()));
+    let r = load_gltf_slice(b"{\"asset\": 7}", None, "bad", &LoadLimits::default());
+    expect("malformed-gltf", r.is_err(), format!("{:?}", r.err()));
+    let r = load_gltf_slice(
+        br#"{"asset":{"version":"2.0"},"buffers":[{"byteLength":1000000000000000}]}"#,
+        None,
+        "huge",
+        &LoadLimits::default(),
+    );
+    expect("absurd-gltf-size", r.is_err(), format!("{:?}", r.err()));
+    let r = load_obj_slice(b"v 0 0 0\nf 1 2 3\n", "bad", &LoadLimits::default());
+    expect("malformed-obj", r.is_err(), format!("{:?}", r.err()));
+    out
+}
+
+fn setup_of(name: &str, meshes: Vec<MeshDesc>, light: Light, camera: Camera) -> SceneSetup {
+    let mut b = SceneBuilder::new();
+    for m in meshes {
+        b.push_mesh(m).expect("stress meshes are valid");
+    }
+    SceneSetup {
+        name: name.into(),
+        scene: Arc::new(b.build().expect("stress scenes are valid")),
+        lights: vec![light],
+        camera: Some(camera),
+        aspect: None,
+        warnings: vec![],
+    }
+}
+
+fn rect_down(center: Vec3, side: f32) -> Light {
+    Arc::new(
+        RectLight::new(
+            center,
+            Vec3::new(0.5 * side, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 0.5 * side),
+            Radiance::Constant(Vec3::ONE),
+        )
+        .expect("valid light"),
+    )
+}
+
+fn camera(eye: Vec3, target: Vec3) -> Camera {
+    Camera::look_at(eye, target, Vec3::Y, 0.9).expect("valid camera")
+}
+
+fn mesh(m: (Vec<Vec3>, Vec<[u32; 3]>)) -> MeshDesc {
+    MeshDesc::new(m.0, m.1)
+}
+
+/// An occluder square made of needle triangles (a fan from one corner with 200 slivers).
+fn sliver_square() -> MeshDesc {
+    let mut p = vec![Vec3::new(-0.3, 1.0, -0.3)];
+    let n = 200;
+    for k in 0..=n {
+        let t = k as f32 / n as f32;
+        p.push(if t <= 0.5 {
+            Vec3::new(0.3, 1.0, -0.3 + 1.2 * t)
+        } else {
+            Vec3::new(0.3 - 1.2 * (t - 0.5), 1.0, 0.3)
+        });
+    }
+    let tris = (0..n as u32).map(|k| [0, k + 2, k + 1]).collect();
+    MeshDesc::new(p, tris)
+}
+
+fn run_on(
+    preset: &Preset,
+    setup: &SceneSetup,
+    view: &ViewSamples,
+    seed: u64,
+) -> Result<(VisibilityImage, bool, Option<LightSampler>), String> {
+    let mut t = (preset.make)(seed);
+    let caps = t.capabilities();
+    caps.check(setup.scene.as_ref(), setup.lights[0].as_ref())?;
+    let (e, _, _) = run_technique(t.as_mut(), setup, setup.lights[0].clone(), view)
+        .map_err(|e| e.to_string())?;
+    e.visibility.validate().map_err(|e| e.to_string())?;
+    let sampler = (caps.sample_based)
+        .then(|| t.light_sampler().cloned())
+        .flatten();
+    Ok((e.visibility, caps.sample_based, sampler))
+}
+
+fn reference_for(
+    setup: &SceneSetup,
+    view: &ViewSamples,
+    sampler: Option<LightSampler>,
+) -> VisibilityImage {
+    let mut r = match sampler {
+        Some(s) => Reference::same_samples(s),
+        None => Reference::stratified(256, 77).expect("valid"),
+    };
+    run_technique(&mut r, setup, setup.lights[0].clone(), view)
+        .expect("the reference runs on stress scenes")
+        .0
+        .visibility
+}
+
+/// RMSE over the pixels valid in both buffers (views of transformed scenes may differ at a few
+/// silhouette pixels).
+fn rmse_common(a: &VisibilityImage, b: &VisibilityImage) -> f64 {
+    let (mut s, mut n) = (0.0, 0u64);
+    for i in 0..a.len().min(b.len()) {
+        if a.is_valid(i) && b.is_valid(i) {
+            let e = (a.value(i) - b.value(i)) as f64;
+            s += e * e;
+            n += 1;
+        }
+    }
+    if n == 0 {
+        f64::NAN
+    } else {
+        (s / n as f64).sqrt()
+    }
+}
+
+/// Technique cases for one preset at `width x height`.
+pub fn technique_cases(preset: &Preset, width: u32, height: u32) -> Vec<StressResult> {
+    let name = preset.name;
+    let mut out = Vec::new();
+    // Against the reference: twice the preset's own RMSE budget on quad-over-plane. Invariance
+    // under scaling and translation: 0.02 RMSE for every technique.
+    let tol = (preset.budget)("quad-over-plane").map_or(0.05, |b| b.rmse.max(0.01) * 2.0);
+    let invariance = 0.02;
+    let base = builtin("quad-over-plane").expect("built-in");
+    let view_of = |s: &SceneSetup| {
+        ViewSamples::render(s.scene.as_ref(), &s.camera_or_default(), width, height)
+            .expect("valid view")
+    };
+    let base_view = view_of(&base);
+    let base_out = run_on(preset, &base, &base_view, 3);
+    // Scale and translation invariance.
+    for (label, scale, shift) in [
+        ("scale-1e-4", 1e-4f32, Vec3::ZERO),
+        ("scale-1e-2", 1e-2, Vec3::ZERO),
+        ("scale-1e2", 1e2, Vec3::ZERO),
+        ("scale-1e5", 1e5, Vec3::ZERO),
+        ("translate-1e5", 1e2, Vec3::splat(1e5)),
+    ] {
+        let moved = transformed(&base, scale, shift).expect("valid transform");
+        let r = match (&base_out, run_on(preset, &moved, &view_of(&moved), 3)) {
+            (Ok((a, ..)), Ok((b, ..))) => {
+                let e = rmse_common(a, &b);
+                result(
+                    label,
+                    name,
+                    e <= invariance,
+                    format!("rmse against the unscaled scene {e:.5} (tolerance {invariance})"),
+                )
+            }
+            (Err(e), _) => result(label, name, false, e.clone()),
+            (_, Err(e)) => result(label, name, false, e),
+        };
+        out.push(r);
+    }
+    // Scenes compared with the reference.
+    let cam = camera(Vec3::new(0.0, 3.2, 3.6), Vec3::new(0.0, 0.2, 0.0));
+    let cases: Vec<(&str, SceneSetup)> = vec![
+        (
+            "sliver-occluder",
+            setup_of(
+                "slivers",
+                vec![mesh(floor(6.0, 0.0)), sliver_square()],
+                rect_down(Vec3::new(0.0, 2.0, 0.0), 1.0),
+                cam,
+            ),
+        ),
+        (
+            "coplanar-and-touching",
+            setup_of(
+                "coplanar",
+                vec![
+                    mesh(floor(6.0, 0.0)),
+                    mesh(quad(
+                        Vec3::new(0.8, 0.0, 0.6),
+                        Vec3::new(0.0, 0.0, 0.5),
+                        Vec3::new(0.5, 0.0, 0.0),
+                    )),
+                    mesh(cuboid(
+                        Vec3::new(-0.6, 0.0, -0.3),
+                        Vec3::new(-0.1, 0.4, 0.2),
+                        false,
+                    )),
+                    mesh(cuboid(
+                        Vec3::new(-0.1, 0.0, -0.3),
+                        Vec3::new(0.3, 0.3, 0.2),
+                        false,
+                    )),
+                ],
+                rect_down(Vec3::new(0.0, 2.0, 0.0), 1.0),
+                cam,
+            ),
+        ),
+        (
+            "grazing-light",
+            setup_of(
+                "grazing",
+                vec![
+                    mesh(floor(6.0, 0.0)),
+                    mesh(cuboid(
+                        Vec3::new(-0.3, 0.0, -0.3),
+                        Vec3::new(0.3, 0.5, 0.3),
+                        false,
+                    )),
+                ],
+                Arc::new(
+                    RectLight::facing(
+                        Vec3::new(-8.0, 0.3, 0.0),
+                        Vec3::new(1.0, -0.02, 0.0),
+                        1.0,
+                        0.5,
+                        Radiance::Constant(Vec3::ONE),
+                    )
+                    .expect("valid"),
+                ),
+                cam,
+            ),
+        ),
+        (
+            "light-larger-than-scene",
+            setup_of(
+                "huge-light",
+                vec![
+                    mesh(floor(6.0, 0.0)),
+                    mesh(cuboid(
+                        Vec3::new(-0.3, 0.5, -0.3),
+                        Vec3::new(0.3, 0.8, 0.3),
+                        false,
+                    )),
+                ],
+                rect_down(Vec3::new(0.0, 2.0, 0.0), 200.0),
+                cam,
+            ),
+        ),
+    ];
+    for (label, setup) in &cases {
+        let view = view_of(setup);
+        out.push(match run_on(preset, setup, &view, 3) {
+            Ok((v, _, sampler)) => {
+                let r = reference_for(setup, &view, sampler);
+                match compare(&v, &r) {
+                    Ok(m) => result(
+                        label,
+                        name,
+                        m.rmse <= tol,
+                        format!(
+                            "rmse against the reference {:.5} (tolerance {tol:.3}), max {:.3}",
+                            m.rmse, m.max_abs
+                        ),
+                    ),
+                    Err(e) => result(label, name, false, e.to_string()),
+                }
+            }
+            Err(e) => result(label, name, false, e),
+        });
+    }
+    // A tiny light tends to the hard shadow.
+    let tiny = setup_of(
+        "tiny-light",
+        vec![
+            mesh(floor(6.0, 0.0)),
+            mesh(quad(
+                Vec3::new(0.0, 1.0, 0.0),
+                Vec3::new(0.3, 0.0, 0.0),
+                Vec3::new(0.0, 0.0, -0.3),
+            )),
+        ],
+        Arc::new(
+            DiskLight::new(
+                Vec3::new(0.1, 2.0, 0.05),
+                Vec3::NEG_Y,
+                1e-5,
+                Radiance::Constant(Vec3::ONE),
+            )
+            .expect("valid"),
+        ),
+        cam,
+    );
+    let view = view_of(&tiny);
+    out.push(match run_on(preset, &tiny, &view, 3) {
+        Ok((v, ..)) => {
+            let mut hard = Reference::hard();
+            let h = run_technique(&mut hard, &tiny, tiny.lights[0].clone(), &view)
+                .expect("reference runs")
+                .0
+                .visibility;
+            let off = (0..v.len())
+                .filter(|&i| v.is_valid(i) && (v.value(i) - h.value(i)).abs() > 0.5)
+                .count();
+            let share = off as f64 / view.valid_count().max(1) as f64;
+            result(
+                "tiny-light-hard-shadow",
+                name,
+                share <= 0.01,
+                format!(
+                    "{:.3}% of pixels differ from the hard shadow by > 0.5",
+                    100.0 * share
+                ),
+            )
+        }
+        Err(e) => result("tiny-light-hard-shadow", name, false, e),
+    });
+    let _ = Affine3A::IDENTITY;
+    out
+}
