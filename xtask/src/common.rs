@@ -1,0 +1,176 @@
+//! Shared helpers: resolving scenes and techniques, machine facts, progress bars.
+
+use std::path::Path;
+use std::sync::Arc;
+use std::time::Duration;
+
+use glam::Vec3;
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
+use shadow_core::load::{LoadLimits, load_scene};
+use shadow_core::prelude::*;
+use shadow_core::scenes::{BUILTIN_SCENES, builtin};
+
+/// A built-in scene by name, or a scene file by path. A file without an emissive mesh gets a
+/// square light above its bounds (said on stderr).
+pub fn resolve_scene(name: &str) -> Result<SceneSetup, String> {
+    if BUILTIN_SCENES.contains(&name) {
+        return builtin(name).map_err(|e| e.to_string());
+    }
+    let path = Path::new(name);
+    if !path.exists() {
+        return Err(format!(
+            "`{name}` is neither a built-in scene nor a file; built-in scenes: {}",
+            BUILTIN_SCENES.join(", ")
+        ));
+    }
+    let mut setup = load_scene(path, &LoadLimits::default()).map_err(|e| e.to_string())?;
+    for w in &setup.warnings {
+        eprintln!("note: {w}");
+    }
+    if setup.lights.is_empty() {
+        let b = setup.scene.bounds();
+        let d = b.diagonal().max(1e-3);
+        let c = Vec3::new(b.center().x, b.max.y + 0.8 * d, b.center().z);
+        let light = RectLight::facing(
+            c,
+            Vec3::NEG_Y,
+            0.25 * d,
+            0.25 * d,
+            Radiance::Constant(Vec3::ONE),
+        )
+        .map_err(|e| e.to_string())?;
+        eprintln!(
+            "note: `{name}` has no emissive mesh; using a square light of side {:.3} at {c}",
+            0.25 * d
+        );
+        setup.lights.push(Arc::new(light));
+    }
+    Ok(setup)
+}
+
+/// A preset by name, optionally with another sample count.
+pub fn resolve_technique(
+    name: &str,
+    samples: Option<u32>,
+    seed: u64,
+) -> Result<Box<dyn ShadowTechnique>, String> {
+    let p = shadow_tests::preset(name)?;
+    match samples {
+        None => Ok((p.make)(seed)),
+        Some(n) => match p.with_samples {
+            Some(f) => Ok(f(n, seed)),
+            None => Err(format!("technique `{name}` has no sample count to set")),
+        },
+    }
+}
+
+/// Prints the built-in scenes.
+pub fn list_scenes() -> Result<(), String> {
+    println!(
+        "{:<24} {:>9} {:>8} {:<10} {}",
+        "scene", "triangles", "closed", "light", "what it exercises"
+    );
+    let what = [
+        "square light over a parallel square occluder (closed form)",
+        "penumbra fusion of overlapping occluders (survey Fig. 6)",
+        "large light close to a small occluder (survey Fig. 7)",
+        "Stanford bunny on a plane",
+        "closed mesh (Spot) shadowing itself",
+        "thin open grass blades, depth complexity far above 255",
+        "objects resting on the floor (contact shadows)",
+        "panels with opacity 0.3 to 0.7",
+        "RGB image on a rectangle light",
+        "omni-directional sphere light inside a room",
+    ];
+    for (name, what) in BUILTIN_SCENES.iter().zip(what) {
+        let s = builtin(name).map_err(|e| e.to_string())?;
+        let comps = s.scene.topology().components();
+        let closed = comps.iter().filter(|c| c.closed).count();
+        println!(
+            "{:<24} {:>9} {:>8} {:<10} {}",
+            name,
+            s.scene.triangle_count(),
+            format!("{closed}/{}", comps.len()),
+            format!("{:?}", s.lights[0].kind()),
+            what
+        );
+    }
+    println!(
+        "\nScaled and translated variants are built by the stress suite (`cargo xtask stress`)."
+    );
+    Ok(())
+}
+
+/// Facts about this machine, recorded beside every measurement.
+#[derive(Debug, Clone, Serialize)]
+pub struct Machine {
+    /// CPU model.
+    pub cpu: String,
+    /// Logical cores.
+    pub cores: usize,
+    /// rayon threads used.
+    pub threads: usize,
+    /// UTC date and time.
+    pub date: String,
+    /// Build profile.
+    pub profile: &'static str,
+}
+
+pub fn machine() -> Machine {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into());
+    let date = std::process::Command::new("date")
+        .args(["-u", "+%Y-%m-%d %H:%M UTC"])
+        .output()
+        .ok()
+        .and_then(|o| String::from_utf8(o.stdout).ok())
+        .map(|s| s.trim().to_string())
+        .unwrap_or_else(|| "unknown".into());
+    Machine {
+        cpu,
+        cores: std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1),
+        threads: rayon::current_num_threads(),
+        date,
+        profile: if cfg!(debug_assertions) {
+            "debug"
+        } else {
+            "release"
+        },
+    }
+}
+
+/// A progress bar over `n` steps (hidden when stderr is not a terminal).
+pub fn progress(n: u64, what: &str) -> ProgressBar {
+    let pb = ProgressBar::new(n);
+    pb.set_style(
+        ProgressStyle::with_template("{spinner} {msg:<40} [{bar:30}] {pos}/{len} {elapsed}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    pb.set_message(what.to_string());
+    pb.enable_steady_tick(Duration::from_millis(200));
+    pb
+}
+
+/// Writes JSON to `path`.
+pub fn write_json(path: &Path, value: &impl Serialize) -> Result<(), String> {
+    let text = serde_json::to_string_pretty(value).map_err(|e| e.to_string())?;
+    std::fs::write(path, text).map_err(|e| format!("writing {}: {e}", path.display()))
+}
+
+/// Occlusion rays per second per thread from a technique's estimate stats, when it counts rays.
+pub fn rays_per_second_per_thread(stats: &Stats) -> Option<f64> {
+    let rays = stats.counter("occlusion-rays");
+    let threads = stats.counter("threads").max(1);
+    let secs = stats.phases.iter().find(|p| p.name == "trace")?.seconds;
+    (rays > 0 && secs > 0.0).then(|| rays as f64 / secs / threads as f64)
+}

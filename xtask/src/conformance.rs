@@ -1,0 +1,233 @@
+//! `cargo xtask conformance`: the main job. Every preset on every supported built-in scene,
+//! against the reference on the same view samples; a table, `report.md`, `report.json` and per
+//! case images (visibility, signed error, shaded).
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use clap::Args;
+use serde_json::json;
+use shadow_core::image_io::{write_error_png, write_shaded_png, write_visibility_png};
+use shadow_core::scenes::{BUILTIN_SCENES, builtin};
+use shadow_tests::conformance::{
+    Outcome, SceneContext, SuiteConfig, reference_curve, reference_time_at, run_case,
+};
+
+use crate::common::{machine, progress, write_json};
+use crate::ensure_dir;
+
+#[derive(Args)]
+pub struct ConformanceArgs {
+    /// Scenes to run (comma-separated; default: all built-in scenes).
+    #[arg(long, value_delimiter = ',')]
+    scenes: Vec<String>,
+    /// Presets to run (comma-separated; default: all registered presets).
+    #[arg(long, value_delimiter = ',')]
+    techniques: Vec<String>,
+    /// Output directory.
+    #[arg(long, default_value = "out/conformance")]
+    out: PathBuf,
+    /// Image width.
+    #[arg(long, default_value_t = 128)]
+    width: u32,
+    /// Image height.
+    #[arg(long, default_value_t = 96)]
+    height: u32,
+    /// Samples per pixel of the reference.
+    #[arg(long, default_value_t = 1024)]
+    ref_samples: u32,
+    /// Seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Skip the determinism and convergence re-runs.
+    #[arg(long)]
+    quick: bool,
+}
+
+/// Reference sample counts of the equal-error speed-up curve.
+const CURVE: [u32; 6] = [1, 4, 16, 64, 256, 1024];
+
+pub fn run(a: ConformanceArgs) -> Result<(), String> {
+    let presets = shadow_tests::registry();
+    for t in &a.techniques {
+        shadow_tests::preset(t)?;
+    }
+    for s in &a.scenes {
+        if !BUILTIN_SCENES.contains(&s.as_str()) {
+            return Err(format!(
+                "unknown scene `{s}`; valid names: {}",
+                BUILTIN_SCENES.join(", ")
+            ));
+        }
+    }
+    let scenes: Vec<&str> = BUILTIN_SCENES
+        .iter()
+        .copied()
+        .filter(|s| a.scenes.is_empty() || a.scenes.iter().any(|x| x == s))
+        .collect();
+    let chosen: Vec<_> = presets
+        .iter()
+        .filter(|p| a.techniques.is_empty() || a.techniques.iter().any(|t| t == p.name))
+        .collect();
+    let cfg = SuiteConfig {
+        width: a.width,
+        height: a.height,
+        ref_samples: a.ref_samples,
+        seed: a.seed,
+        extra_checks: !a.quick,
+    };
+    ensure_dir(&a.out)?;
+    let pb = progress((scenes.len() * (chosen.len() + 1)) as u64, "conformance");
+    let mut rows = Vec::new();
+    let mut failures = Vec::new();
+    let mut md = String::new();
+    let m = machine();
+    writeln!(md, "# Conformance report\n\n{} x {} pixels, reference {} samples per pixel, seed {}. Machine: {} ({} threads), {}.\n", a.width, a.height, a.ref_samples, a.seed, m.cpu, m.threads, m.date).ok();
+    writeln!(md, "Speed-up: the reference's time at the technique's RMSE (log-log interpolation of the reference at {CURVE:?} samples) divided by the technique's time; `>` when the technique beats every reference run.\n").ok();
+    writeln!(md, "| technique | scene | RMSE | penumbra RMSE | bias | max | share > 0.1 | phases (s) | speed-up | status |\n|---|---|---|---|---|---|---|---|---|---|").ok();
+    println!(
+        "{:<12} {:<22} {:>8} {:>8} {:>8} {:>6} {:>7} {:>28} {:>9}  status",
+        "technique", "scene", "RMSE", "pen.RMSE", "bias", "max", ">0.1", "phases (s)", "speed-up"
+    );
+    for scene in &scenes {
+        pb.set_message(format!("{scene}: reference"));
+        let ctx = SceneContext::new(builtin(scene).map_err(|e| e.to_string())?, cfg)?;
+        let curve = reference_curve(&ctx, &CURVE)?;
+        let dir = a.out.join(scene);
+        ensure_dir(&dir)?;
+        let (reference, ref_secs) = ctx.reference()?;
+        write_visibility_png(&dir.join("reference.png"), reference).map_err(|e| e.to_string())?;
+        write_shaded_png(
+            &dir.join("reference-shaded.png"),
+            ctx.setup.scene.as_ref(),
+            &ctx.view,
+            ctx.light().as_ref(),
+            reference,
+        )
+        .map_err(|e| e.to_string())?;
+        pb.inc(1);
+        for p in &chosen {
+            pb.set_message(format!("{scene}: {}", p.name));
+            let outcome = run_case(p, &ctx);
+            pb.inc(1);
+            match outcome {
+                Outcome::Unsupported { reason } => {
+                    println!("{:<12} {:<22} unsupported: {reason}", p.name, scene);
+                    writeln!(
+                        md,
+                        "| {} | {} | | | | | | | | unsupported: {} |",
+                        p.name, scene, reason
+                    )
+                    .ok();
+                    rows.push(json!({"technique": p.name, "scene": scene, "status": "unsupported", "reason": reason}));
+                }
+                Outcome::Failed { error } => {
+                    println!("{:<12} {:<22} FAILED: {error}", p.name, scene);
+                    writeln!(
+                        md,
+                        "| {} | {} | | | | | | | | FAILED: {} |",
+                        p.name, scene, error
+                    )
+                    .ok();
+                    failures.push(format!("{} on {scene}: {error}", p.name));
+                    rows.push(json!({"technique": p.name, "scene": scene, "status": "failed", "error": error}));
+                }
+                Outcome::Ran(r) => {
+                    let case_dir = dir.join(p.name);
+                    ensure_dir(&case_dir)?;
+                    write_visibility_png(&case_dir.join("visibility.png"), &r.estimate)
+                        .map_err(|e| e.to_string())?;
+                    write_error_png(&case_dir.join("error.png"), &r.estimate, &r.reference, 0.5)
+                        .map_err(|e| e.to_string())?;
+                    write_shaded_png(
+                        &case_dir.join("shaded.png"),
+                        ctx.setup.scene.as_ref(),
+                        &ctx.view,
+                        ctx.light().as_ref(),
+                        &r.estimate,
+                    )
+                    .map_err(|e| e.to_string())?;
+                    let phases = r
+                        .prepare_stats
+                        .phases
+                        .iter()
+                        .chain(&r.estimate_stats.phases)
+                        .map(|ph| format!("{} {:.3}", ph.name, ph.seconds))
+                        .collect::<Vec<_>>()
+                        .join(", ");
+                    let speedup = match reference_time_at(&curve, r.metrics.rmse) {
+                        Some(t) => format!("{:.2}x", t / r.seconds),
+                        None => format!(
+                            ">{:.2}x",
+                            curve.last().map_or(0.0, |c| c.seconds) / r.seconds
+                        ),
+                    };
+                    let status = if r.passed() {
+                        "ok".to_string()
+                    } else {
+                        format!("FAIL: {}", r.violations.join("; "))
+                    };
+                    for v in &r.violations {
+                        failures.push(format!("{} on {scene}: {v}", p.name));
+                    }
+                    let pen = r
+                        .metrics
+                        .penumbra_rmse
+                        .map_or("-".to_string(), |v| format!("{v:.4}"));
+                    println!(
+                        "{:<12} {:<22} {:>8.4} {:>8} {:>+8.4} {:>6.3} {:>7.4} {:>28} {:>9}  {}",
+                        p.name,
+                        scene,
+                        r.metrics.rmse,
+                        pen,
+                        r.metrics.bias,
+                        r.metrics.max_abs,
+                        r.metrics.share_over_0_1,
+                        phases,
+                        speedup,
+                        status
+                    );
+                    writeln!(
+                        md,
+                        "| {} | {} | {:.4} | {} | {:+.4} | {:.3} | {:.4} | {} | {} | {} |",
+                        p.name,
+                        scene,
+                        r.metrics.rmse,
+                        pen,
+                        r.metrics.bias,
+                        r.metrics.max_abs,
+                        r.metrics.share_over_0_1,
+                        phases,
+                        speedup,
+                        status
+                    )
+                    .ok();
+                    let mut row = serde_json::to_value(&*r).map_err(|e| e.to_string())?;
+                    row["status"] = json!(if r.passed() { "ok" } else { "fail" });
+                    row["speedup_at_equal_error"] =
+                        json!(reference_time_at(&curve, r.metrics.rmse).map(|t| t / r.seconds));
+                    row["reference_curve"] = json!(curve);
+                    row["reference_seconds_high"] = json!(ref_secs);
+                    rows.push(row);
+                }
+            }
+        }
+    }
+    pb.finish_and_clear();
+    writeln!(md, "\nImages per case in `<scene>/<technique>/`: `visibility.png`, `error.png` (signed error, blue = too dark, red = too bright, full scale 0.5) and `shaded.png`; the reference in `<scene>/reference.png`.").ok();
+    std::fs::write(a.out.join("report.md"), md).map_err(|e| e.to_string())?;
+    write_json(
+        &a.out.join("report.json"),
+        &json!({"machine": m, "config": cfg, "cases": rows}),
+    )?;
+    println!("\nreport: {}", a.out.join("report.md").display());
+    if failures.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "{} conformance failures:\n{}",
+            failures.len(),
+            failures.join("\n")
+        ))
+    }
+}

@@ -1,0 +1,122 @@
+//! `cargo xtask render`: view samples of a scene and, with a technique, its visibility.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args;
+use serde_json::json;
+use shadow_core::image_io::{
+    write_normal_exr, write_position_exr, write_shaded_png, write_visibility_exr,
+    write_visibility_png,
+};
+use shadow_core::prelude::*;
+
+use crate::common::{
+    machine, progress, rays_per_second_per_thread, resolve_scene, resolve_technique, write_json,
+};
+use crate::ensure_dir;
+
+#[derive(Args)]
+pub struct RenderArgs {
+    /// Built-in scene name or a .gltf/.glb/.obj file.
+    #[arg(long)]
+    scene: String,
+    /// Technique preset (see `cargo xtask conformance --help`); view samples only when absent.
+    #[arg(long)]
+    technique: Option<String>,
+    /// Samples per pixel, for presets with a sample count.
+    #[arg(long)]
+    samples: Option<u32>,
+    /// Image width.
+    #[arg(long, default_value_t = 512)]
+    width: u32,
+    /// Image height (default: from the camera's aspect ratio, else 3/4 of the width).
+    #[arg(long)]
+    height: Option<u32>,
+    /// Seed of the technique's sampling.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Output directory.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+pub fn run(a: RenderArgs) -> Result<(), String> {
+    let setup = resolve_scene(&a.scene)?;
+    let mut technique = match &a.technique {
+        Some(t) => Some(resolve_technique(t, a.samples, a.seed)?),
+        None => None,
+    };
+    if a.technique.is_none() && a.samples.is_some() {
+        return Err("--samples needs --technique".into());
+    }
+    let height = a.height.unwrap_or_else(|| match setup.aspect {
+        Some(r) if r > 0.0 && r.is_finite() => ((a.width as f32 / r).round() as u32).max(1),
+        _ => (a.width * 3 / 4).max(1),
+    });
+    ensure_dir(&a.out)?;
+    let pb = progress(if technique.is_some() { 4 } else { 2 }, "view samples");
+    let camera = setup.camera_or_default();
+    let t0 = Instant::now();
+    let view = ViewSamples::render(setup.scene.as_ref(), &camera, a.width, height)
+        .map_err(|e| e.to_string())?;
+    let view_seconds = t0.elapsed().as_secs_f64();
+    pb.inc(1);
+    write_position_exr(&a.out.join("position.exr"), &view).map_err(|e| e.to_string())?;
+    write_normal_exr(&a.out.join("normal.exr"), &view).map_err(|e| e.to_string())?;
+    pb.inc(1);
+    let mut stats = json!({
+        "scene": setup.name,
+        "triangles": setup.scene.triangle_count(),
+        "light": format!("{:?}", setup.lights[0].kind()),
+        "width": a.width,
+        "height": height,
+        "valid_pixels": view.valid_count(),
+        "seed": a.seed,
+        "threads": rayon::current_num_threads(),
+        "gpu_adapter": serde_json::Value::Null,
+        "view_samples_seconds": view_seconds,
+        "machine": machine(),
+    });
+    if let Some(t) = technique.as_mut() {
+        pb.set_message(format!("{}: prepare", t.name()));
+        let prep = t
+            .prepare(setup.scene.clone(), setup.lights[0].clone())
+            .map_err(|e| e.to_string())?;
+        pb.inc(1);
+        pb.set_message(format!("{}: estimate", t.name()));
+        let est = t.estimate(&view).map_err(|e| e.to_string())?;
+        pb.inc(1);
+        write_visibility_exr(&a.out.join("visibility.exr"), &est.visibility)
+            .map_err(|e| e.to_string())?;
+        write_visibility_png(&a.out.join("visibility.png"), &est.visibility)
+            .map_err(|e| e.to_string())?;
+        write_shaded_png(
+            &a.out.join("shaded.png"),
+            setup.scene.as_ref(),
+            &view,
+            setup.lights[0].as_ref(),
+            &est.visibility,
+        )
+        .map_err(|e| e.to_string())?;
+        stats["technique"] = json!(t.name());
+        stats["parameters"] = t.parameters();
+        stats["samples"] = t.light_sampler().map_or(json!(null), |s| json!(s.count()));
+        stats["prepare"] = serde_json::to_value(&prep).map_err(|e| e.to_string())?;
+        stats["estimate"] = serde_json::to_value(&est.stats).map_err(|e| e.to_string())?;
+        stats["classes"] = json!(est.visibility.class_counts());
+        if let Some(r) = rays_per_second_per_thread(&est.stats) {
+            stats["occlusion_rays_per_second_per_thread"] = json!(r);
+        }
+    }
+    pb.finish_and_clear();
+    write_json(&a.out.join("stats.json"), &stats)?;
+    println!(
+        "wrote {} ({}x{}, {} valid pixels)",
+        a.out.display(),
+        a.width,
+        height,
+        view.valid_count()
+    );
+    Ok(())
+}

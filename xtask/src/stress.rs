@@ -1,0 +1,55 @@
+//! `cargo xtask stress`: the numerical-stability suite against every registered preset.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use shadow_tests::stress::{input_cases, technique_cases};
+
+use crate::common::{machine, write_json};
+use crate::ensure_dir;
+
+#[derive(Args)]
+pub struct StressArgs {
+    /// Image width of the technique cases.
+    #[arg(long, default_value_t = 96)]
+    width: u32,
+    /// Image height of the technique cases.
+    #[arg(long, default_value_t = 72)]
+    height: u32,
+    /// Only these presets (comma-separated).
+    #[arg(long, value_delimiter = ',')]
+    techniques: Vec<String>,
+    /// Where to write stress.json.
+    #[arg(long, default_value = "out/stress")]
+    out: PathBuf,
+}
+
+pub fn run(a: StressArgs) -> Result<(), String> {
+    let mut results = input_cases();
+    for p in shadow_tests::registry() {
+        if a.techniques.is_empty() || a.techniques.iter().any(|t| t == p.name) {
+            results.extend(technique_cases(&p, a.width, a.height));
+        }
+    }
+    println!("{:<26} {:<12} {:<7} detail", "case", "technique", "result");
+    for r in &results {
+        println!(
+            "{:<26} {:<12} {:<7} {}",
+            r.case,
+            r.technique,
+            if r.held { "held" } else { "FAILED" },
+            r.detail
+        );
+    }
+    let failed = results.iter().filter(|r| !r.held).count();
+    println!("\n{} held, {} failed", results.len() - failed, failed);
+    ensure_dir(&a.out)?;
+    write_json(
+        &a.out.join("stress.json"),
+        &serde_json::json!({"machine": machine(), "results": results}),
+    )?;
+    if failed > 0 {
+        return Err(format!("{failed} stress cases failed"));
+    }
+    Ok(())
+}
