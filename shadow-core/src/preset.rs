@@ -68,6 +68,9 @@ impl Budget {
     }
 }
 
+/// Builds a technique with a given sample count and seed.
+pub type WithSamples = fn(samples: u32, seed: u64) -> Box<dyn ShadowTechnique>;
+
 /// A named, constructible technique configuration with its budgets.
 #[derive(Clone, Copy)]
 pub struct Preset {
@@ -81,7 +84,7 @@ pub struct Preset {
     pub budget: fn(scene: &str) -> Option<Budget>,
     /// For sample-based presets: the same technique with another sample count, used by the
     /// convergence check (error must fall as samples grow).
-    pub with_samples: Option<fn(samples: u32, seed: u64) -> Box<dyn ShadowTechnique>>,
+    pub with_samples: Option<WithSamples>,
 }
 
 impl std::fmt::Debug for Preset {

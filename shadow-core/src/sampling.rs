@@ -129,11 +129,15 @@ impl LightSampler {
     /// A jittered set: one uniform point in each cell of the grid, cells in row-major order.
     fn jittered_set(&self, key: &[u64]) -> Vec<Vec2> {
         let mut out = Vec::with_capacity(self.count as usize);
+        self.jittered_into(hash_words(key), &mut out);
+        out
+    }
+
+    /// Appends the jittered set of `base` (a hash of the set's key) to `out`.
+    fn jittered_into(&self, base: u64, out: &mut Vec<Vec2>) {
         for k in 0..self.count {
             let (cx, cy) = (k % self.grid.x, k / self.grid.x);
-            let mut words = key.to_vec();
-            words.push(k as u64);
-            let h = hash_words(&words);
+            let h = mix64(base ^ mix64(k as u64 ^ 0x6a09_e667_f3bc_c909));
             let jx = unit_float(h);
             let jy = unit_float(mix64(h));
             out.push(Vec2::new(
@@ -141,7 +145,6 @@ impl LightSampler {
                 ((cy as f32 + jy) / self.grid.y as f32).min(ONE_MINUS),
             ));
         }
-        out
     }
 
     /// The unit-square samples of pixel `pixel` (x, y), written into `out` (cleared first).
@@ -157,9 +160,10 @@ impl LightSampler {
                     (s - s.floor()).min(Vec2::splat(ONE_MINUS))
                 }));
             }
-            SamplingStrategy::Stratified => {
-                out.extend(self.jittered_set(&[self.seed, 0x57, pixel.x as u64, pixel.y as u64]))
-            }
+            SamplingStrategy::Stratified => self.jittered_into(
+                hash_words(&[self.seed, 0x57, pixel.x as u64, pixel.y as u64]),
+                out,
+            ),
             SamplingStrategy::Interleaved { tile } => {
                 let k = (pixel.y % tile) * tile + pixel.x % tile;
                 out.extend_from_slice(&self.sets[k as usize]);
@@ -179,7 +183,7 @@ impl LightSampler {
 /// Grid `(x, y)` with `x * y = count` and `x` the largest divisor not above `sqrt(count)`.
 fn strata(count: u32) -> UVec2 {
     let mut x = (count as f64).sqrt().floor() as u32;
-    while x > 1 && count % x != 0 {
+    while x > 1 && !count.is_multiple_of(x) {
         x -= 1;
     }
     let x = x.max(1);

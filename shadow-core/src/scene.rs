@@ -127,7 +127,8 @@ pub trait Scene: Send + Sync {
         let [a, b, c] = self.triangle(t);
         triangle_normal(a, b, c).unwrap_or(Vec3::Z)
     }
-    /// True when some triangle is not fully opaque, so opacity handling is needed.
+    /// True when some triangle is not fully opaque, so opacity handling is needed (implementors
+    /// should cache it: techniques ask per pixel).
     fn has_semi_opaque(&self) -> bool {
         self.opacities().iter().any(|&o| o < 1.0)
     }
@@ -159,6 +160,7 @@ pub struct TriangleScene {
     topology: Topology,
     bounds: Aabb,
     dropped_degenerate: usize,
+    semi_opaque: bool,
 }
 
 impl TriangleScene {
@@ -217,6 +219,9 @@ impl Scene for TriangleScene {
     }
     fn albedo(&self, triangle: usize) -> Vec3 {
         self.albedos[triangle]
+    }
+    fn has_semi_opaque(&self) -> bool {
+        self.semi_opaque
     }
 }
 
@@ -379,7 +384,7 @@ impl SceneBuilder {
                 for (i, n) in ns.iter().enumerate() {
                     let w = normal_from_mesh * glam::Vec3A::from(*n);
                     let len = w.length();
-                    if !n.is_finite() || !(len > 0.0 && len.is_finite()) {
+                    if !(n.is_finite() && len > 0.0 && len.is_finite()) {
                         return Err(SceneError::InvalidNormal {
                             index: base + i,
                             value: n.to_array(),
@@ -495,6 +500,7 @@ impl SceneBuilder {
         });
         let topology = Topology::build(&triangles);
         let bounds = Aabb::from_points(&positions);
+        let semi_opaque = opacities.iter().any(|&o| o < 1.0);
         Ok(TriangleScene {
             positions,
             triangles,
@@ -504,6 +510,7 @@ impl SceneBuilder {
             topology,
             bounds,
             dropped_degenerate: dropped,
+            semi_opaque,
         })
     }
 }

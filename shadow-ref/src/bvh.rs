@@ -33,12 +33,18 @@ impl Boundable for PaddedTriangle {
 /// A BVH over a scene's triangles answering occlusion queries.
 pub struct OcclusionBvh {
     bvh: CwBvh,
-    /// Triangles in BVH order (`primitive_indices` applied), as three corners.
-    tris: Vec<[Vec3A; 3]>,
+    /// Triangles in BVH order (`primitive_indices` applied): three corners and the original id
+    /// in one 64-byte record, so a leaf test touches one cache line.
+    tris: Vec<BvhTriangle>,
     /// Transmittance (1 - opacity) in BVH order.
     transmittance: Vec<f32>,
-    /// Original triangle id in BVH order.
-    ids: Vec<u32>,
+}
+
+#[derive(Clone, Copy)]
+#[repr(C, align(64))]
+struct BvhTriangle {
+    v: [Vec3A; 3],
+    id: u32,
 }
 
 impl std::fmt::Debug for OcclusionBvh {
@@ -68,13 +74,16 @@ impl OcclusionBvh {
             .collect();
         let bvh = obvhs::cwbvh::builder::build_cwbvh(
             &prims,
-            BvhBuildParams::medium_build(),
+            BvhBuildParams::slow_build(),
             &mut Duration::default(),
         );
-        let ids: Vec<u32> = bvh.primitive_indices.clone();
+        let ids = &bvh.primitive_indices;
         let tris = ids
             .iter()
-            .map(|&t| scene.triangle(t as usize).map(Vec3A::from))
+            .map(|&t| BvhTriangle {
+                v: scene.triangle(t as usize).map(Vec3A::from),
+                id: t,
+            })
             .collect();
         let transmittance = ids
             .iter()
@@ -84,7 +93,6 @@ impl OcclusionBvh {
             bvh,
             tris,
             transmittance,
-            ids,
         }
     }
 
@@ -100,10 +108,11 @@ impl OcclusionBvh {
         let sheared = ShearedRay::new(o, d);
         let ray = Ray::new(o, d, 0.0, t_max);
         !self.bvh.ray_traverse_miss(ray, |_, id| {
-            if self.ids[id] == ignore {
+            let tri = &self.tris[id];
+            if tri.id == ignore {
                 return f32::INFINITY;
             }
-            let [a, b, c] = self.tris[id];
+            let [a, b, c] = tri.v;
             sheared
                 .intersect(a, b, c, 0.0, t_max)
                 .unwrap_or(f32::INFINITY)
@@ -119,10 +128,11 @@ impl OcclusionBvh {
         let ray = Ray::new(o, d, 0.0, t_max);
         let mut hits: Vec<u32> = Vec::new();
         self.bvh.ray_traverse_anyhit(ray, |_, id| {
-            if self.ids[id] == ignore {
+            let tri = &self.tris[id];
+            if tri.id == ignore {
                 return;
             }
-            let [a, b, c] = self.tris[id];
+            let [a, b, c] = tri.v;
             if sheared.intersect(a, b, c, 0.0, t_max).is_some() {
                 hits.push(id as u32);
             }
@@ -141,10 +151,10 @@ impl OcclusionBvh {
         let sheared = ShearedRay::new(o, d);
         let mut out: Vec<u32> = (0..self.tris.len())
             .filter(|&i| {
-                let [a, b, c] = self.tris[i];
+                let [a, b, c] = self.tris[i].v;
                 sheared.intersect(a, b, c, 0.0, t_max).is_some()
             })
-            .map(|i| self.ids[i])
+            .map(|i| self.tris[i].id)
             .collect();
         out.sort_unstable();
         out

@@ -8,7 +8,7 @@
 //! * [`bvh`]: an `obvhs` CWBVH with occlusion (`ray_traverse_miss`) and any-hit queries;
 //! * [`watertight`]: the watertight ray-triangle test of Woop, Benthin and Wald (JCGT 2013);
 //! * [`offset`]: robust ray origins after Wachter and Binder (Ray Tracing Gems ch. 6);
-//! * [`reference`]: the [`Reference`] technique.
+//! * [`mod@reference`]: the [`Reference`] technique.
 //!
 //! ```
 //! use shadow_core::prelude::*;

@@ -41,6 +41,7 @@ pub enum SampleSource {
 
 struct Prepared {
     scene: SceneRef,
+    semi_opaque: bool,
     light: Light,
     bvh: OcclusionBvh,
     offset: RayOffset,
@@ -171,6 +172,32 @@ impl Reference {
         Ok(segment(self.prepared()?, s, y))
     }
 
+    /// Every occlusion segment the reference casts for `view`, in pixel and sample order:
+    /// (origin, unit direction, length, receiver triangle). For benchmarks and peer
+    /// comparisons on identical rays.
+    ///
+    /// # Errors
+    /// [`TechniqueError::NotPrepared`] before `prepare`.
+    pub fn segments(
+        &self,
+        view: &ViewSamples,
+    ) -> Result<Vec<(Vec3, Vec3, f32, u32)>, TechniqueError> {
+        let p = self.prepared()?;
+        let (mut units, mut samples) = (Vec::new(), Vec::new());
+        let mut out = Vec::new();
+        for i in 0..view.len() {
+            let Some(s) = view.get(i) else { continue };
+            self.pixel_samples(p.light.as_ref(), s.pixel, &mut units, &mut samples);
+            let origin = p.offset.offset(s.position, s.geometric_normal);
+            for y in &samples {
+                if let Some((o, d, t)) = segment_from(origin, &s, y.position) {
+                    out.push((o, d, t, s.triangle));
+                }
+            }
+        }
+        Ok(out)
+    }
+
     /// Visibility of each light sample from view sample `s` (transmittance in [0, 1]), and the
     /// number of rays cast.
     fn sample_visibility(
@@ -181,10 +208,11 @@ impl Reference {
         vis: &mut Vec<f32>,
     ) -> u64 {
         vis.clear();
-        let semi = p.scene.has_semi_opaque();
+        let semi = p.semi_opaque;
         let mut rays = 0;
+        let origin = p.offset.offset(s.position, s.geometric_normal);
         for y in samples {
-            let Some((origin, dir, t_max)) = segment(p, s, y.position) else {
+            let Some((origin, dir, t_max)) = segment_from(origin, s, y.position) else {
                 vis.push(0.0);
                 continue;
             };
@@ -230,10 +258,15 @@ impl Reference {
 }
 
 fn segment(p: &Prepared, s: &ViewSample, y: Vec3) -> Option<(Vec3, Vec3, f32)> {
+    segment_from(p.offset.offset(s.position, s.geometric_normal), s, y)
+}
+
+/// The segment from the offset `origin` of view sample `s` to `y` (see [`Reference::segment`]).
+#[inline]
+fn segment_from(origin: Vec3, s: &ViewSample, y: Vec3) -> Option<(Vec3, Vec3, f32)> {
     if (y - s.position).dot(s.geometric_normal) <= 0.0 {
         return None;
     }
-    let origin = p.offset.offset(s.position, s.geometric_normal);
     let d = y - origin;
     if d.dot(s.geometric_normal) <= 0.0 {
         return None;
@@ -320,6 +353,7 @@ impl ShadowTechnique for Reference {
             light
         };
         self.prepared = Some(Prepared {
+            semi_opaque: scene.has_semi_opaque(),
             scene,
             light,
             bvh,

@@ -10,6 +10,9 @@ use shadow_core::prelude::*;
 use shadow_core::preset::{Budget, Preset};
 use shadow_ref::Reference;
 
+/// Mixed into the seed of the stratified reference so its samples differ from a technique's.
+pub const REFERENCE_SEED_SALT: u64 = 0x005e_ed0f_7e5e;
+
 /// Image size, reference sample count and seed of a run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct SuiteConfig {
@@ -80,7 +83,7 @@ impl SceneContext {
     pub fn reference(&self) -> Result<&(VisibilityImage, f64), String> {
         self.reference
             .get_or_init(|| {
-                let seed = self.config.seed ^ 0x5eed_0f_7e5e;
+                let seed = self.config.seed ^ REFERENCE_SEED_SALT;
                 let mut r = Reference::stratified(self.config.ref_samples, seed)
                     .map_err(|e| e.to_string())?;
                 run_technique(&mut r, &self.setup, self.light(), &self.view)
@@ -298,8 +301,9 @@ pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
                 let (e, _, _) = run_technique(t.as_mut(), &ctx.setup, ctx.light(), &ctx.view)
                     .map_err(|e| e.to_string())?;
                 let r = if t.capabilities().sample_based {
-                    let mut r = Reference::stratified(cfg.ref_samples, cfg.seed ^ 0x5eed_0f_7e5e)
-                        .map_err(|e| e.to_string())?;
+                    let mut r =
+                        Reference::stratified(cfg.ref_samples, cfg.seed ^ REFERENCE_SEED_SALT)
+                            .map_err(|e| e.to_string())?;
                     run_technique(&mut r, &ctx.setup, ctx.light(), &ctx.view)
                         .map_err(|e| e.to_string())?
                         .0

@@ -50,6 +50,9 @@ pub struct BenchArgs {
     /// Smaller sweeps (for a quick look).
     #[arg(long)]
     quick: bool,
+    /// Also write the bunny occlusion rays and triangles for `scripts/embree_peer.py`.
+    #[arg(long)]
+    export_rays: bool,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -108,6 +111,15 @@ fn timed(
         last = Some(e);
     }
     Ok((median(runs.clone()), runs, last.expect("at least one run")))
+}
+
+/// Technique parameters without the sample count and name, to recognise identical sweeps.
+fn without_samples(mut v: serde_json::Value) -> serde_json::Value {
+    if let Some(o) = v.as_object_mut() {
+        o.remove("samples");
+        o.remove("name");
+    }
+    v
 }
 
 fn sphere_scene(rings: u32) -> SceneSetup {
@@ -235,6 +247,7 @@ pub fn run(a: BenchArgs) -> Result<(), String> {
             })?;
             pb.inc(1);
         }
+        let mut swept: Vec<(serde_json::Value, String)> = Vec::new();
         for p in &presets {
             pb.set_message(format!("{scene}: {}", p.name));
             let caps = (p.make)(seed).capabilities();
@@ -247,6 +260,18 @@ pub fn run(a: BenchArgs) -> Result<(), String> {
             }
             match p.with_samples {
                 Some(f) => {
+                    // Presets that differ only in their default sample count share one sweep.
+                    let params = without_samples(f(sweep[0], seed).parameters());
+                    if let Some(first) = swept
+                        .iter()
+                        .find(|(q, _)| *q == params)
+                        .map(|(_, n)| n.clone())
+                    {
+                        println!("{scene}: {} shares the sample sweep of {first}", p.name);
+                        pb.inc(sweep.len() as u64);
+                        continue;
+                    }
+                    swept.push((params, p.name.to_string()));
                     for &n in &sweep {
                         record(p.name, Some(n), &|| f(n, seed))?;
                         pb.inc(1);
@@ -359,6 +384,13 @@ pub fn run(a: BenchArgs) -> Result<(), String> {
         all / 1e6,
         m.threads
     );
+    let query = query_throughput(&bunny, &a, seed)?;
+    println!(
+        "bunny occlusion query alone on {} identical rays, one thread: {:.2} M rays/s ({:.1}% occluded)",
+        query.rays,
+        query.rays_per_second / 1e6,
+        100.0 * query.occluded_share
+    );
 
     // Files.
     let mut csv = format!(
@@ -400,6 +432,7 @@ pub fn run(a: BenchArgs) -> Result<(), String> {
             "machine": m, "width": a.width, "height": a.height, "repeats": a.repeats, "ground_truth_samples": truth_samples,
             "time_error": points, "scaling": scaling,
             "throughput": {"scene": "bunny", "size": size, "samples": 64, "rays_per_second_one_thread": one, "rays_per_second_per_thread_all": all, "threads": m.threads},
+        "query_throughput": query,
         }),
     )?;
     for scene in &a.scenes {
@@ -496,4 +529,72 @@ pub fn run(a: BenchArgs) -> Result<(), String> {
     )?;
     println!("wrote {}", a.out.display());
     Ok(())
+}
+
+#[derive(Debug, Clone, Serialize)]
+struct QueryThroughput {
+    rays: usize,
+    rays_per_second: f64,
+    occluded_share: f64,
+}
+
+/// The BVH occlusion query alone, one thread, on the exact rays of `ref-64` for bunny at
+/// 160x120 (the rays a peer ray tracer is given by `--export-rays`).
+fn query_throughput(
+    bunny: &SceneSetup,
+    a: &BenchArgs,
+    seed: u64,
+) -> Result<QueryThroughput, String> {
+    let view = ViewSamples::render(bunny.scene.as_ref(), &bunny.camera_or_default(), 160, 120)
+        .map_err(|e| e.to_string())?;
+    let mut r = Reference::stratified(64, seed).map_err(|e| e.to_string())?;
+    r.prepare(bunny.scene.clone(), bunny.lights[0].clone())
+        .map_err(|e| e.to_string())?;
+    let segs = r.segments(&view).map_err(|e| e.to_string())?;
+    let bvh = r.bvh().ok_or("reference not prepared")?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .map_err(|e| e.to_string())?;
+    let (best, occluded) = pool.install(|| {
+        let mut best = f64::INFINITY;
+        let mut occluded = 0;
+        for _ in 0..=a.repeats {
+            let t0 = Instant::now();
+            occluded = segs
+                .iter()
+                .filter(|(o, d, t, tri)| bvh.occluded(*o, *d, *t, *tri))
+                .count();
+            best = best.min(t0.elapsed().as_secs_f64());
+        }
+        (best, occluded)
+    });
+    if a.export_rays {
+        let mut rays = Vec::with_capacity(segs.len() * 28);
+        for (o, d, t, _) in &segs {
+            for v in [o.x, o.y, o.z, d.x, d.y, d.z, *t] {
+                rays.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        std::fs::write(a.out.join("bunny-rays.bin"), rays).map_err(|e| e.to_string())?;
+        let mut tris = Vec::new();
+        for t in 0..bunny.scene.triangle_count() {
+            for p in bunny.scene.triangle(t) {
+                for v in p.to_array() {
+                    tris.extend_from_slice(&v.to_le_bytes());
+                }
+            }
+        }
+        std::fs::write(a.out.join("bunny-triangles.bin"), tris).map_err(|e| e.to_string())?;
+        println!(
+            "wrote {} rays and {} triangles for scripts/embree_peer.py",
+            segs.len(),
+            bunny.scene.triangle_count()
+        );
+    }
+    Ok(QueryThroughput {
+        rays: segs.len(),
+        rays_per_second: segs.len() as f64 / best,
+        occluded_share: occluded as f64 / segs.len().max(1) as f64,
+    })
 }

@@ -68,8 +68,8 @@ pub fn resolve_technique(
 /// Prints the built-in scenes.
 pub fn list_scenes() -> Result<(), String> {
     println!(
-        "{:<24} {:>9} {:>8} {:<10} {}",
-        "scene", "triangles", "closed", "light", "what it exercises"
+        "{:<24} {:>9} {:>8} {:<10} what it exercises",
+        "scene", "triangles", "closed", "light"
     );
     let what = [
         "square light over a parallel square occluder (closed form)",

@@ -92,6 +92,10 @@ fn draw<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc(x_label)
         .y_desc(y_label)
+        .x_labels(8)
+        .y_labels(8)
+        .x_label_formatter(&|v| short(*v))
+        .y_label_formatter(&|v| short(*v))
         .label_style(("sans-serif", 14))
         .draw()
         .map_err(err)?;
@@ -142,6 +146,19 @@ fn draw<DB: DrawingBackend>(
         .map_err(err)?;
     root.present().map_err(err)?;
     Ok(())
+}
+
+/// A tick label with two significant digits and no float noise.
+fn short(v: f64) -> String {
+    if !(v > 0.0) || !v.is_finite() {
+        return format!("{v}");
+    }
+    let decimals = (1 - v.log10().floor() as i32).max(0) as usize;
+    if v >= 1e5 || v < 1e-4 {
+        format!("{v:.1e}")
+    } else {
+        format!("{v:.decimals$}")
+    }
 }
 
 /// The lower-left Pareto front (time, error) of all points.
