@@ -154,7 +154,7 @@ fn short(v: f64) -> String {
         return format!("{v}");
     }
     let decimals = (1 - v.log10().floor() as i32).max(0) as usize;
-    if v >= 1e5 || v < 1e-4 {
+    if !(1e-4..1e5).contains(&v) {
         format!("{v:.1e}")
     } else {
         format!("{v:.decimals$}")
