@@ -7,15 +7,17 @@
 //! the traversal cannot reject a ray that the exact triangle test would accept (flat boxes of
 //! axis-aligned triangles and rays through box faces).
 
-use std::time::Duration;
-
 use glam::{Vec3, Vec3A};
 use obvhs::aabb::Aabb as BvhAabb;
+use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::cwbvh::CwBvh;
+use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
+use obvhs::ploc::PlocBuilder;
 use obvhs::ray::Ray;
 use obvhs::{Boundable, BvhBuildParams};
 use shadow_core::Scene;
 
+use crate::beam::Beam;
 use crate::watertight::ShearedRay;
 
 #[derive(Clone, Copy)]
@@ -36,8 +38,31 @@ pub struct OcclusionBvh {
     /// Triangles in BVH order (`primitive_indices` applied): three corners and the original id
     /// in one 64-byte record, so a leaf test touches one cache line.
     tris: Vec<BvhTriangle>,
-    /// Transmittance (1 - opacity) in BVH order.
-    transmittance: Vec<f32>,
+    /// The BVH2 the CWBVH was made from, for beam traversal.
+    beam_nodes: Vec<BeamNode>,
+    beam_prims: Vec<u32>,
+    /// Triangles and transmittances by scene id (candidate tests).
+    by_id: Vec<[Vec3A; 3]>,
+    transmittance_by_id: Vec<f32>,
+}
+
+#[derive(Clone, Copy)]
+struct BeamNode {
+    min: Vec3A,
+    max: Vec3A,
+    prim_count: u32,
+    first: u32,
+}
+
+/// What a beam traversal found for one receiver.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BeamResult {
+    /// No triangle can touch the beam: every segment inside it is unoccluded.
+    Clear,
+    /// These many candidates (written to the output list) may block segments.
+    Candidates(usize),
+    /// More candidates than the limit: use the per-segment BVH query.
+    TooMany,
 }
 
 #[derive(Clone, Copy)]
@@ -72,11 +97,32 @@ impl OcclusionBvh {
                 }
             })
             .collect();
-        let bvh = obvhs::cwbvh::builder::build_cwbvh(
+        // obvhs's `build_cwbvh`, step by step, keeping the BVH2 for beam culling.
+        let params = BvhBuildParams::slow_build();
+        let mut bvh2 = PlocBuilder::with_capacity(prims.len()).build(
+            params.ploc_search_distance,
             &prims,
-            BvhBuildParams::slow_build(),
-            &mut Duration::default(),
+            (0..prims.len() as u32).collect::<Vec<_>>(),
+            params.sort_precision,
+            params.search_depth_threshold,
         );
+        ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
+        let bvh = bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false);
+        let beam_nodes = bvh2
+            .nodes
+            .iter()
+            .map(|n| BeamNode {
+                min: n.aabb.min,
+                max: n.aabb.max,
+                prim_count: n.prim_count,
+                first: n.first_index,
+            })
+            .collect();
+        let beam_prims = bvh2.primitive_indices.clone();
+        let by_id: Vec<[Vec3A; 3]> = (0..scene.triangle_count())
+            .map(|t| scene.triangle(t).map(Vec3A::from))
+            .collect();
+        let transmittance_by_id: Vec<f32> = scene.opacities().iter().map(|o| 1.0 - o).collect();
         let ids = &bvh.primitive_indices;
         let tris = ids
             .iter()
@@ -85,14 +131,13 @@ impl OcclusionBvh {
                 id: t,
             })
             .collect();
-        let transmittance = ids
-            .iter()
-            .map(|&t| 1.0 - scene.opacities()[t as usize])
-            .collect();
         Self {
             bvh,
             tris,
-            transmittance,
+            beam_nodes,
+            beam_prims,
+            by_id,
+            transmittance_by_id,
         }
     }
 
@@ -134,14 +179,98 @@ impl OcclusionBvh {
             }
             let [a, b, c] = tri.v;
             if sheared.intersect(a, b, c, 0.0, t_max).is_some() {
-                hits.push(id as u32);
+                hits.push(tri.id);
             }
         });
         hits.sort_unstable();
         hits.dedup();
-        let t = hits
+        let t = hits.iter().fold(1.0f32, |acc, &id| {
+            acc * self.transmittance_by_id[id as usize]
+        });
+        (t, hits.len() as u32)
+    }
+
+    /// Collects into `out` the triangles (scene ids, `ignore` excepted) that may touch `beam`,
+    /// traversing the BVH2; stops at `limit` candidates.
+    pub fn beam_candidates(
+        &self,
+        beam: &Beam,
+        ignore: u32,
+        limit: usize,
+        out: &mut Vec<u32>,
+    ) -> BeamResult {
+        out.clear();
+        if self.beam_nodes.is_empty() {
+            return BeamResult::Clear;
+        }
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.beam_nodes[stack[top] as usize];
+            if beam.box_outside(node.min, node.max) {
+                continue;
+            }
+            if node.prim_count > 0 {
+                for k in node.first..node.first + node.prim_count {
+                    let id = self.beam_prims[k as usize];
+                    if id != ignore && !beam.triangle_outside(&self.by_id[id as usize]) {
+                        if out.len() == limit {
+                            return BeamResult::TooMany;
+                        }
+                        out.push(id);
+                    }
+                }
+            } else if top + 2 <= stack.len() {
+                stack[top] = node.first;
+                stack[top + 1] = node.first + 1;
+                top += 2;
+            } else {
+                // Deeper than the stack: give up on the beam, the per-segment query is exact.
+                return BeamResult::TooMany;
+            }
+        }
+        if out.is_empty() {
+            BeamResult::Clear
+        } else {
+            BeamResult::Candidates(out.len())
+        }
+    }
+
+    /// Segment test against a candidate list: true when one of them blocks it.
+    pub fn occluded_by(&self, candidates: &[u32], origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+        let (o, d) = ray_parts(origin, dir);
+        let sheared = ShearedRay::new(o, d);
+        candidates.iter().any(|&id| {
+            let [a, b, c] = self.by_id[id as usize];
+            sheared.intersect(a, b, c, 0.0, t_max).is_some()
+        })
+    }
+
+    /// Transmittance product over the candidates a segment crosses, and their count. The
+    /// product runs in increasing triangle id, as in [`OcclusionBvh::transmittance`], so both
+    /// paths give bit-identical results.
+    pub fn transmittance_by(
+        &self,
+        candidates: &[u32],
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+    ) -> (f32, u32) {
+        let (o, d) = ray_parts(origin, dir);
+        let sheared = ShearedRay::new(o, d);
+        let mut hits: Vec<u32> = candidates
             .iter()
-            .fold(1.0f32, |acc, &h| acc * self.transmittance[h as usize]);
+            .copied()
+            .filter(|&id| {
+                let [a, b, c] = self.by_id[id as usize];
+                sheared.intersect(a, b, c, 0.0, t_max).is_some()
+            })
+            .collect();
+        hits.sort_unstable();
+        let t = hits.iter().fold(1.0f32, |acc, &id| {
+            acc * self.transmittance_by_id[id as usize]
+        });
         (t, hits.len() as u32)
     }
 

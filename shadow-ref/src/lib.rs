@@ -5,6 +5,7 @@
 //! illumination (DCS eq. 6), semi-opaque occluders by the exact transmittance product, and the
 //! point-light hard shadow.
 //!
+//! * [`beam`]: conservative beam culling of a receiver's segments to a planar light;
 //! * [`bvh`]: an `obvhs` CWBVH with occlusion (`ray_traverse_miss`) and any-hit queries;
 //! * [`watertight`]: the watertight ray-triangle test of Woop, Benthin and Wald (JCGT 2013);
 //! * [`offset`]: robust ray origins after Wachter and Binder (Ray Tracing Gems ch. 6);
@@ -24,6 +25,7 @@
 
 #![deny(missing_docs)]
 
+pub mod beam;
 pub mod bvh;
 pub mod offset;
 mod presets;

@@ -25,7 +25,8 @@ use shadow_core::light::{LightKind, LightSample, PointLight};
 use shadow_core::prelude::*;
 use shadow_core::sampling::SamplingError;
 
-use crate::bvh::OcclusionBvh;
+use crate::beam::{Beam, light_quad};
+use crate::bvh::{BeamResult, OcclusionBvh};
 use crate::offset::RayOffset;
 
 /// Where the reference takes its light samples from.
@@ -39,7 +40,41 @@ pub enum SampleSource {
     Hard,
 }
 
+/// Receivers with fewer samples than this skip the beam (a single ray is cheaper).
+const BEAM_MIN_SAMPLES: usize = 4;
+/// Largest candidate list tested segment by segment; beyond it the BVH answers each segment.
+const BEAM_CANDIDATES: usize = 16;
+
+/// Per-thread buffers reused across receivers.
+#[derive(Default)]
+struct Scratch {
+    vis: Vec<f32>,
+    candidates: Vec<u32>,
+}
+
+/// Work counters of one receiver (or a row of them).
+#[derive(Default, Clone, Copy)]
+struct Counts {
+    rays: u64,
+    traversed: u64,
+    beam_clear: u64,
+    beam_candidates: u64,
+    beam_fallback: u64,
+}
+
+impl Counts {
+    fn add(&mut self, o: &Counts) {
+        self.rays += o.rays;
+        self.traversed += o.traversed;
+        self.beam_clear += o.beam_clear;
+        self.beam_candidates += o.beam_candidates;
+        self.beam_fallback += o.beam_fallback;
+    }
+}
+
 struct Prepared {
+    quad: Option<[Vec3; 4]>,
+    beam_eps: f32,
     scene: SceneRef,
     semi_opaque: bool,
     light: Light,
@@ -53,6 +88,7 @@ pub struct Reference {
     source: SampleSource,
     sampler: LightSampler,
     per_sample: bool,
+    beam: bool,
     prepared: Option<Prepared>,
 }
 
@@ -84,6 +120,7 @@ impl Reference {
             source: SampleSource::Stratified,
             sampler: LightSampler::new(SamplingStrategy::Stratified, samples, seed)?,
             per_sample: false,
+            beam: true,
             prepared: None,
         })
     }
@@ -95,6 +132,7 @@ impl Reference {
             source: SampleSource::Same,
             sampler,
             per_sample: true,
+            beam: true,
             prepared: None,
         }
     }
@@ -107,6 +145,7 @@ impl Reference {
             sampler: LightSampler::new(SamplingStrategy::Correlated, 1, 0)
                 .expect("one sample is valid"),
             per_sample: true,
+            beam: true,
             prepared: None,
         }
     }
@@ -115,6 +154,14 @@ impl Reference {
     #[must_use]
     pub fn with_per_sample(mut self, on: bool) -> Self {
         self.per_sample = on;
+        self
+    }
+
+    /// Turns beam culling on (the default) or off. Off, every segment is a single-ray BVH query;
+    /// the answers are identical either way (the tests check it), only the time differs.
+    #[must_use]
+    pub fn with_beam(mut self, on: bool) -> Self {
+        self.beam = on;
         self
     }
 
@@ -205,27 +252,66 @@ impl Reference {
         p: &Prepared,
         s: &ViewSample,
         samples: &[LightSample],
-        vis: &mut Vec<f32>,
-    ) -> u64 {
+        scratch: &mut Scratch,
+    ) -> Counts {
+        let vis = &mut scratch.vis;
         vis.clear();
-        let semi = p.semi_opaque;
-        let mut rays = 0;
+        let mut counts = Counts::default();
         let origin = p.offset.offset(s.position, s.geometric_normal);
+        // One beam per receiver when there are enough samples to share it.
+        let beam = match p.quad {
+            Some(q) if self.beam && samples.len() >= BEAM_MIN_SAMPLES => {
+                Beam::new(origin, q, p.beam_eps)
+            }
+            _ => None,
+        };
+        let mode = match beam {
+            Some(b) => {
+                p.bvh
+                    .beam_candidates(&b, s.triangle, BEAM_CANDIDATES, &mut scratch.candidates)
+            }
+            None => BeamResult::TooMany,
+        };
+        match (beam.is_some(), mode) {
+            (false, _) => {}
+            (true, BeamResult::Clear) => counts.beam_clear = 1,
+            (true, BeamResult::Candidates(_)) => counts.beam_candidates = 1,
+            (true, BeamResult::TooMany) => counts.beam_fallback = 1,
+        }
+        let cands = &scratch.candidates;
         for y in samples {
             let Some((origin, dir, t_max)) = segment_from(origin, s, y.position) else {
                 vis.push(0.0);
                 continue;
             };
-            rays += 1;
-            vis.push(if semi {
-                p.bvh.transmittance(origin, dir, t_max, s.triangle).0
-            } else if p.bvh.occluded(origin, dir, t_max, s.triangle) {
-                0.0
-            } else {
-                1.0
+            counts.rays += 1;
+            vis.push(match (mode, p.semi_opaque) {
+                (BeamResult::Clear, _) => 1.0,
+                (BeamResult::Candidates(_), true) => {
+                    p.bvh.transmittance_by(cands, origin, dir, t_max).0
+                }
+                (BeamResult::Candidates(_), false) => {
+                    if p.bvh.occluded_by(cands, origin, dir, t_max) {
+                        0.0
+                    } else {
+                        1.0
+                    }
+                }
+                (BeamResult::TooMany, true) => {
+                    counts.traversed += 1;
+                    p.bvh.transmittance(origin, dir, t_max, s.triangle).0
+                }
+                (BeamResult::TooMany, false) => {
+                    counts.traversed += 1;
+                    if p.bvh.occluded(origin, dir, t_max, s.triangle) {
+                        0.0
+                    } else {
+                        1.0
+                    }
+                }
             });
         }
-        rays
+        counts
     }
 
     /// Direct illumination of every view sample (DCS eq. 6 with the exact transmittance).
@@ -237,13 +323,15 @@ impl Reference {
         let w = view.width() as usize;
         let mut out = vec![Vec3::ZERO; view.len()];
         out.par_chunks_mut(w).enumerate().for_each(|(row, line)| {
-            let (mut units, mut samples, mut vis) = (Vec::new(), Vec::new(), Vec::new());
+            let (mut units, mut samples, mut scratch) =
+                (Vec::new(), Vec::new(), Scratch::default());
             for (x, px) in line.iter_mut().enumerate() {
                 let Some(s) = view.get(row * w + x) else {
                     continue;
                 };
                 self.pixel_samples(p.light.as_ref(), s.pixel, &mut units, &mut samples);
-                self.sample_visibility(p, &s, &samples, &mut vis);
+                self.sample_visibility(p, &s, &samples, &mut scratch);
+                let vis = &scratch.vis;
                 let albedo = p.scene.albedo(s.triangle as usize);
                 let light: &dyn AreaLight = if self.source == SampleSource::Hard {
                     &HardLight(p.light.center())
@@ -332,6 +420,7 @@ impl ShadowTechnique for Reference {
             "strategy": format!("{:?}", self.sampler.strategy()),
             "seed": self.sampler.seed(),
             "per_sample": self.per_sample,
+            "beam_culling": self.beam,
         })
     }
 
@@ -352,7 +441,16 @@ impl ShadowTechnique for Reference {
         } else {
             light
         };
+        let bounds = scene.bounds().union(light.bounds());
+        let coord = bounds.min.abs().max(bounds.max.abs()).max_element();
+        let quad = if self.source == SampleSource::Hard {
+            None
+        } else {
+            light_quad(&light.geometry())
+        };
         self.prepared = Some(Prepared {
+            quad,
+            beam_eps: 1e-5 * extent.max(f32::MIN_POSITIVE) + 8.0 * f32::EPSILON * coord,
             semi_opaque: scene.has_semi_opaque(),
             scene,
             light,
@@ -380,6 +478,7 @@ impl ShadowTechnique for Reference {
             bits: Vec<u64>,
             rays: u64,
             below: u64,
+            counts: Counts,
         }
         let rows: Vec<Row> = stats.time("trace", || {
             (0..view.height() as usize)
@@ -392,22 +491,26 @@ impl ShadowTechnique for Reference {
                         bits: vec![0; if self.per_sample { w * words } else { 0 }],
                         rays: 0,
                         below: 0,
+                        counts: Counts::default(),
                     };
-                    let (mut units, mut samples, mut vis) = (Vec::new(), Vec::new(), Vec::new());
+                    let (mut units, mut samples, mut scratch) =
+                        (Vec::new(), Vec::new(), Scratch::default());
                     for x in 0..w {
                         let Some(s) = view.get(row * w + x) else {
                             continue;
                         };
                         self.pixel_samples(p.light.as_ref(), s.pixel, &mut units, &mut samples);
-                        let rays = self.sample_visibility(p, &s, &samples, &mut vis);
-                        r.rays += rays;
-                        r.below += samples.len() as u64 - rays;
+                        let c = self.sample_visibility(p, &s, &samples, &mut scratch);
+                        let vis = &scratch.vis;
+                        r.rays += c.rays;
+                        r.below += samples.len() as u64 - c.rays;
+                        r.counts.add(&c);
                         let sum: f64 = vis.iter().map(|&v| v as f64).sum();
                         r.v[x] = (sum / n as f64) as f32;
                         if textured {
                             let acc = samples
                                 .iter()
-                                .zip(&vis)
+                                .zip(vis)
                                 .fold(Vec3::ZERO, |a, (s, v)| a + s.radiance * *v);
                             r.rgb[x] = acc / n as f32;
                         }
@@ -452,6 +555,10 @@ impl ShadowTechnique for Reference {
             bits.extend_from_slice(&r.bits);
             stats.add("occlusion-rays", r.rays);
             stats.add("samples-below-horizon", r.below);
+            stats.add("rays-traversed", r.counts.traversed);
+            stats.add("pixels-beam-clear", r.counts.beam_clear);
+            stats.add("pixels-beam-candidates", r.counts.beam_candidates);
+            stats.add("pixels-beam-fallback", r.counts.beam_fallback);
         }
         stats.add("pixels", view.valid_count() as u64);
         stats.add("threads", rayon::current_num_threads() as u64);

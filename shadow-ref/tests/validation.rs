@@ -502,3 +502,20 @@ fn semi_opaque_occluders_multiply_transmittances() {
     );
     let _ = UVec2::ZERO;
 }
+
+#[test]
+fn beam_culling_changes_nothing_but_time() {
+    // Per-sample answers and coefficients with and without beam culling, on every built-in
+    // scene (semi-opaque transmittance and the sphere light's no-beam path included).
+    for name in BUILTIN_SCENES {
+        let setup = builtin(name).unwrap();
+        let view =
+            ViewSamples::render(setup.scene.as_ref(), &setup.camera.unwrap(), 32, 24).unwrap();
+        let sampler = LightSampler::new(SamplingStrategy::Stratified, 64, 8).unwrap();
+        let with = run(&mut Reference::same_samples(sampler.clone()), &setup, &view);
+        let mut plain = Reference::same_samples(sampler).with_beam(false);
+        let without = run(&mut plain, &setup, &view);
+        assert_eq!(with.coefficients(), without.coefficients(), "{name}");
+        assert_eq!(with.per_sample(), without.per_sample(), "{name}");
+    }
+}

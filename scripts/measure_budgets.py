@@ -1,0 +1,38 @@
+#!/usr/bin/env python3
+"""Regenerates the measured-error tables behind the presets' budgets.
+
+    cargo test --profile test -p shadow-tests --test conformance every_preset_on_every \
+        -- --nocapture | grep -E '^[a-z]' | python3 scripts/measure_budgets.py FILE.rs PRESET=CONST ...
+
+Each `PRESET=CONST` pair rewrites `const CONST: &[(&str, [f64; 5])] = &[...]` in FILE.rs with
+the errors the suite printed for PRESET (rmse, penumbra rmse, bias, max, share > 0.1). Budgets
+are these numbers with the margins of `Budget::from_measured`. Only rerun this when a change is
+meant to move a technique's error (a new sampler, a fixed bug), and say so in the commit.
+"""
+import sys
+
+
+def main() -> None:
+    path, pairs = sys.argv[1], dict(a.split("=") for a in sys.argv[2:])
+    rows = {}
+    for line in sys.stdin:
+        t = line.split()
+        if len(t) < 12 or t[2] != "rmse":
+            continue
+        vals = [float(t[3]), float(t[5]), float(t[7]), float(t[9]), float(t[11])]
+        rows.setdefault(t[0], []).append((t[1], vals))
+    src = open(path).read()
+    for preset, const in pairs.items():
+        body = "\n".join(
+            f'    ("{scene}", [{v[0]:.4f}, {v[1]:.4f}, {v[2]:.4f}, {v[3]:.3f}, {v[4]:.4f}]),'
+            for scene, v in rows[preset]
+        )
+        head = f"const {const}: &[(&str, [f64; 5])] = &["
+        a = src.index(head)
+        b = src.index("];", a)
+        src = src[:a] + head + "\n" + body + "\n" + src[b:]
+    open(path, "w").write(src)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,171 @@
+//! Beam culling for the occlusion segments of one receiver: every segment from a view sample's
+//! (offset) origin to a planar light lies inside the pyramid with the origin as apex and the
+//! light's bounding rectangle as base. Triangles the pyramid cannot touch cannot block any of
+//! those segments, so one traversal of the BVH2 with the pyramid answers a fully lit receiver
+//! for all its samples at once, and gives a short candidate list to the others. The per-segment
+//! test on the candidates is the same watertight test as the single-ray path, so the answer is
+//! identical (a conservative cull, never an approximation).
+
+use glam::{Vec3, Vec3A};
+use shadow_core::geometry::orthonormal_basis;
+use shadow_core::light::LightGeometry;
+
+/// A pyramid (apex and a base quad), tested conservatively against boxes and triangles.
+#[derive(Debug, Clone, Copy)]
+pub struct Beam {
+    /// Unit normals pointing out of the pyramid, and offsets: outside when `n . x > d + eps`.
+    planes: [(Vec3A, f32); 5],
+    lo: Vec3A,
+    hi: Vec3A,
+    eps: f32,
+}
+
+/// The base quad of the beam for a planar light: its bounding rectangle in its own plane (the
+/// rectangle itself, the square around a disk, the bounding rectangle of a polygon). `None`
+/// for spheres and points.
+pub fn light_quad(geometry: &LightGeometry<'_>) -> Option<[Vec3; 4]> {
+    match *geometry {
+        LightGeometry::Rectangle {
+            center,
+            half_u,
+            half_v,
+            ..
+        } => Some([
+            center - half_u - half_v,
+            center + half_u - half_v,
+            center + half_u + half_v,
+            center - half_u + half_v,
+        ]),
+        LightGeometry::Disk {
+            center,
+            normal,
+            radius,
+        } => {
+            let (t, b) = orthonormal_basis(normal);
+            let (t, b) = (t * radius, b * radius);
+            Some([
+                center - t - b,
+                center + t - b,
+                center + t + b,
+                center - t + b,
+            ])
+        }
+        LightGeometry::Polygon { outline, normal } => {
+            let (t, b) = orthonormal_basis(normal);
+            let o = outline[0];
+            let (mut lo, mut hi) = (
+                glam::Vec2::splat(f32::INFINITY),
+                glam::Vec2::splat(f32::NEG_INFINITY),
+            );
+            for p in outline {
+                let l = glam::Vec2::new((*p - o).dot(t), (*p - o).dot(b));
+                lo = lo.min(l);
+                hi = hi.max(l);
+            }
+            let at = |x: f32, y: f32| o + t * x + b * y;
+            Some([
+                at(lo.x, lo.y),
+                at(hi.x, lo.y),
+                at(hi.x, hi.y),
+                at(lo.x, hi.y),
+            ])
+        }
+        LightGeometry::Sphere { .. } | LightGeometry::Point { .. } => None,
+    }
+}
+
+impl Beam {
+    /// The pyramid from `apex` to the convex quad `base` (corners in order). `eps` is the
+    /// distance slack of every plane test (use a small multiple of the scene's float precision).
+    /// `None` when the pyramid is degenerate (apex on the base plane).
+    pub fn new(apex: Vec3, base: [Vec3; 4], eps: f32) -> Option<Self> {
+        let a = Vec3A::from(apex);
+        let q = base.map(Vec3A::from);
+        let centroid = (q[0] + q[1] + q[2] + q[3]) * 0.25;
+        let mut planes = [(Vec3A::ZERO, 0.0); 5];
+        for i in 0..4 {
+            let n = (q[i] - a).cross(q[(i + 1) % 4] - a);
+            let n = n.try_normalize()?;
+            let n = if n.dot(centroid - a) > 0.0 { -n } else { n };
+            planes[i] = (n, n.dot(a));
+        }
+        let n = (q[1] - q[0]).cross(q[3] - q[0]).try_normalize()?;
+        let n = if n.dot(a - q[0]) > 0.0 { -n } else { n };
+        if n.dot(a - q[0]).abs() <= eps {
+            return None;
+        }
+        planes[4] = (n, n.dot(q[0]));
+        let lo = q.iter().fold(a, |m, p| m.min(*p));
+        let hi = q.iter().fold(a, |m, p| m.max(*p));
+        Some(Self {
+            planes,
+            lo,
+            hi,
+            eps,
+        })
+    }
+
+    /// True when the box `[min, max]` lies entirely outside the pyramid.
+    #[inline]
+    pub fn box_outside(&self, min: Vec3A, max: Vec3A) -> bool {
+        if min.cmpgt(self.hi + Vec3A::splat(self.eps)).any()
+            || max.cmplt(self.lo - Vec3A::splat(self.eps)).any()
+        {
+            return true;
+        }
+        let c = 0.5 * (min + max);
+        let e = 0.5 * (max - min);
+        self.planes
+            .iter()
+            .any(|(n, d)| n.dot(c) - n.abs().dot(e) > d + self.eps)
+    }
+
+    /// True when the triangle lies entirely outside one face of the pyramid.
+    #[inline]
+    pub fn triangle_outside(&self, v: &[Vec3A; 3]) -> bool {
+        self.planes
+            .iter()
+            .any(|(n, d)| v.iter().all(|p| n.dot(*p) > d + self.eps))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pyramid_contains_its_segments_and_rejects_outside_boxes() {
+        let base = [
+            Vec3::new(-1.0, 2.0, -1.0),
+            Vec3::new(1.0, 2.0, -1.0),
+            Vec3::new(1.0, 2.0, 1.0),
+            Vec3::new(-1.0, 2.0, 1.0),
+        ];
+        let beam = Beam::new(Vec3::ZERO, base, 1e-6).unwrap();
+        // A tiny box around a point on a segment from the apex to the base is never outside.
+        for k in 0..=10 {
+            let t = k as f32 / 10.0;
+            for corner in base {
+                let p = Vec3A::from(corner * t);
+                assert!(!beam.box_outside(p - Vec3A::splat(1e-4), p + Vec3A::splat(1e-4)));
+            }
+        }
+        assert!(beam.box_outside(Vec3A::new(3.0, 0.5, 0.0), Vec3A::new(4.0, 1.0, 1.0)));
+        assert!(beam.box_outside(Vec3A::new(-0.5, 2.5, -0.5), Vec3A::new(0.5, 3.0, 0.5)));
+        assert!(beam.box_outside(Vec3A::new(-0.5, -1.0, -0.5), Vec3A::new(0.5, -0.5, 0.5)));
+        assert!(!beam.box_outside(Vec3A::new(-0.1, 0.9, -0.1), Vec3A::new(0.1, 1.1, 0.1)));
+        let inside = [
+            Vec3A::new(0.0, 1.0, 0.0),
+            Vec3A::new(0.2, 1.0, 0.0),
+            Vec3A::new(0.0, 1.0, 0.2),
+        ];
+        assert!(!beam.triangle_outside(&inside));
+        let outside = [
+            Vec3A::new(2.0, 1.0, 0.0),
+            Vec3A::new(2.2, 1.0, 0.0),
+            Vec3A::new(2.0, 1.0, 0.2),
+        ];
+        assert!(beam.triangle_outside(&outside));
+        assert!(Beam::new(Vec3::new(0.0, 2.0, 0.0), base, 1e-6).is_none());
+    }
+}
