@@ -28,11 +28,15 @@ pub struct SuiteConfig {
     pub extra_checks: bool,
 }
 
+/// The image size every budget was measured at. Max error is a tail statistic that grows with
+/// the pixel count, so it is enforced only at this size; RMSE, bias and shares hold at any size.
+pub const BUDGET_RESOLUTION: (u32, u32) = (128, 96);
+
 impl Default for SuiteConfig {
     fn default() -> Self {
         Self {
-            width: 64,
-            height: 48,
+            width: BUDGET_RESOLUTION.0,
+            height: BUDGET_RESOLUTION.1,
             ref_samples: 1024,
             seed: 1,
             extra_checks: true,
@@ -144,6 +148,8 @@ pub struct CaseReport {
     pub budget: Option<Budget>,
     /// Every check that failed, in words.
     pub violations: Vec<String>,
+    /// Observations that are not failures (e.g. max error at another image size).
+    pub notes: Vec<String>,
     /// Same seed, same output (`None` when not checked).
     pub deterministic: Option<bool>,
     /// RMSE at 16 and at 256 samples (sample-count presets).
@@ -197,7 +203,25 @@ pub fn false_shadow_share(
     if n == 0 { 0.0 } else { bad as f64 / n as f64 }
 }
 
-fn check_budget(m: &Metrics, false_shadow: f64, b: &Budget, v: &mut Vec<String>) {
+fn check_budget(
+    m: &Metrics,
+    false_shadow: f64,
+    b: &Budget,
+    enforce_max: bool,
+    v: &mut Vec<String>,
+    notes: &mut Vec<String>,
+) {
+    if m.max_abs > b.max_abs && !enforce_max {
+        notes.push(format!(
+            "max error {:.5} above the budget {:.5} measured at {}x{} (not enforced at this size)",
+            m.max_abs, b.max_abs, BUDGET_RESOLUTION.0, BUDGET_RESOLUTION.1
+        ));
+    }
+    let max_limit = if enforce_max {
+        b.max_abs
+    } else {
+        f64::INFINITY
+    };
     let mut over = |what: &str, got: f64, limit: f64| {
         if got > limit || got.is_nan() {
             v.push(format!("{what} {got:.5} exceeds budget {limit:.5}"));
@@ -208,7 +232,7 @@ fn check_budget(m: &Metrics, false_shadow: f64, b: &Budget, v: &mut Vec<String>)
         over("penumbra rmse", p, b.penumbra_rmse);
     }
     over("|bias|", m.bias.abs(), b.bias);
-    over("max error", m.max_abs, b.max_abs);
+    over("max error", m.max_abs, max_limit);
     over("share > 0.1", m.share_over_0_1, b.share_over_0_1);
     over("false shadow", false_shadow, b.false_shadow);
     if let Some(min) = b.min_sample_agreement {
@@ -276,8 +300,17 @@ pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
     };
     let false_shadow = false_shadow_share(&est.visibility, &reference);
     let budget = (preset.budget)(&ctx.setup.name);
+    let mut notes = Vec::new();
+    let enforce_max = (cfg.width, cfg.height) == BUDGET_RESOLUTION;
     match &budget {
-        Some(b) => check_budget(&metrics, false_shadow, b, &mut violations),
+        Some(b) => check_budget(
+            &metrics,
+            false_shadow,
+            b,
+            enforce_max,
+            &mut violations,
+            &mut notes,
+        ),
         None => violations.push("the preset declares no budget for this scene".into()),
     }
     let mut deterministic = None;
@@ -337,6 +370,7 @@ pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
         false_shadow,
         budget,
         violations,
+        notes,
         deterministic,
         convergence,
         parameters: tech.parameters(),

@@ -10,7 +10,8 @@ use serde_json::json;
 use shadow_core::image_io::{write_error_png, write_shaded_png, write_visibility_png};
 use shadow_core::scenes::{BUILTIN_SCENES, builtin};
 use shadow_tests::conformance::{
-    Outcome, SceneContext, SuiteConfig, reference_curve, reference_time_at, run_case,
+    BUDGET_RESOLUTION, Outcome, SceneContext, SuiteConfig, reference_curve, reference_time_at,
+    run_case,
 };
 
 use crate::common::{machine, progress, write_json};
@@ -27,11 +28,11 @@ pub struct ConformanceArgs {
     /// Output directory.
     #[arg(long, default_value = "out/conformance")]
     out: PathBuf,
-    /// Image width.
-    #[arg(long, default_value_t = 128)]
+    /// Image width (budgets' max-error bounds hold at the default 128x96).
+    #[arg(long, default_value_t = BUDGET_RESOLUTION.0)]
     width: u32,
     /// Image height.
-    #[arg(long, default_value_t = 96)]
+    #[arg(long, default_value_t = BUDGET_RESOLUTION.1)]
     height: u32,
     /// Samples per pixel of the reference.
     #[arg(long, default_value_t = 1024)]
@@ -166,6 +167,11 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
                         "ok".to_string()
                     } else {
                         format!("FAIL: {}", r.violations.join("; "))
+                    };
+                    let status = if r.notes.is_empty() {
+                        status
+                    } else {
+                        format!("{status} (note: {})", r.notes.join("; "))
                     };
                     for v in &r.violations {
                         failures.push(format!("{} on {scene}: {v}", p.name));
