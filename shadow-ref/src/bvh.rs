@@ -164,6 +164,39 @@ impl OcclusionBvh {
         })
     }
 
+    /// The id of a triangle (not `ignore`) strictly between `origin` and `origin + dir * t_max`,
+    /// if any: the occlusion query that also says by what.
+    pub fn occluder(&self, origin: Vec3, dir: Vec3, t_max: f32, ignore: u32) -> Option<u32> {
+        let (o, d) = ray_parts(origin, dir);
+        let sheared = ShearedRay::new(o, d);
+        let ray = Ray::new(o, d, 0.0, t_max);
+        let found = std::cell::Cell::new(u32::MAX);
+        let miss = self.bvh.ray_traverse_miss(ray, |_, id| {
+            let tri = &self.tris[id];
+            if tri.id == ignore {
+                return f32::INFINITY;
+            }
+            let [a, b, c] = tri.v;
+            match sheared.intersect(a, b, c, 0.0, t_max) {
+                Some(t) => {
+                    found.set(tri.id);
+                    t
+                }
+                None => f32::INFINITY,
+            }
+        });
+        (!miss).then(|| found.get())
+    }
+
+    /// True when triangle `id` blocks the segment.
+    pub fn blocks(&self, id: u32, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+        let (o, d) = ray_parts(origin, dir);
+        let [a, b, c] = self.by_id[id as usize];
+        ShearedRay::new(o, d)
+            .intersect(a, b, c, 0.0, t_max)
+            .is_some()
+    }
+
     /// Product of `1 - opacity` over every distinct triangle strictly between `origin` and
     /// `origin + dir * t_max`, `ignore` excepted (0 as soon as an opaque triangle is crossed), and the number of
     /// surfaces crossed.

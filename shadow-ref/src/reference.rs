@@ -279,6 +279,7 @@ impl Reference {
             (true, BeamResult::TooMany) => counts.beam_fallback = 1,
         }
         let cands = &scratch.candidates;
+        let mut last = u32::MAX;
         for y in samples {
             let Some((origin, dir, t_max)) = segment_from(origin, s, y.position) else {
                 vis.push(0.0);
@@ -302,11 +303,19 @@ impl Reference {
                     p.bvh.transmittance(origin, dir, t_max, s.triangle).0
                 }
                 (BeamResult::TooMany, false) => {
-                    counts.traversed += 1;
-                    if p.bvh.occluded(origin, dir, t_max, s.triangle) {
+                    // Shadow cache: the triangle that blocked the previous segment of this
+                    // receiver is tried first; neighbouring samples usually share it.
+                    if last != u32::MAX && p.bvh.blocks(last, origin, dir, t_max) {
                         0.0
                     } else {
-                        1.0
+                        counts.traversed += 1;
+                        match p.bvh.occluder(origin, dir, t_max, s.triangle) {
+                            Some(id) => {
+                                last = id;
+                                0.0
+                            }
+                            None => 1.0,
+                        }
                     }
                 }
             });
