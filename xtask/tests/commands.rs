@@ -1,0 +1,111 @@
+//! The xtask commands a new user runs first, exercised through the built binary.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn xtask(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_xtask"))
+        .args(args)
+        .output()
+        .expect("xtask runs")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("xtask-test-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+#[test]
+fn scenes_lists_every_builtin_scene() {
+    let out = xtask(&["scenes"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    for name in shadow_core::scenes::BUILTIN_SCENES {
+        assert!(text.contains(name), "{name} missing from:\n{text}");
+    }
+}
+
+#[test]
+fn render_writes_view_samples_and_visibility() {
+    let dir = temp_dir("render");
+    let d = dir.to_str().unwrap();
+    let out = xtask(&["render", "--scene", "bunny", "--width", "48", "--out", d]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in ["position.exr", "normal.exr", "stats.json"] {
+        assert!(dir.join(f).is_file(), "{f} missing");
+    }
+    assert!(!dir.join("visibility.exr").exists());
+    let out = xtask(&[
+        "render",
+        "--scene",
+        "bunny",
+        "--technique",
+        "ref",
+        "--samples",
+        "16",
+        "--width",
+        "48",
+        "--out",
+        d,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in ["visibility.exr", "visibility.png", "shaded.png"] {
+        assert!(dir.join(f).is_file(), "{f} missing");
+    }
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("stats.json")).unwrap()).unwrap();
+    assert_eq!(stats["technique"], "ref-16");
+    assert_eq!(stats["samples"], 16);
+    assert_eq!(stats["width"], 48);
+    assert!(
+        stats["estimate"]["counters"]["occlusion-rays"]
+            .as_u64()
+            .unwrap()
+            > 0
+    );
+    assert!(
+        stats["occlusion_rays_per_second_per_thread"]
+            .as_f64()
+            .unwrap()
+            > 0.0
+    );
+    let exr = image::open(dir.join("visibility.exr"))
+        .unwrap()
+        .to_rgba32f();
+    assert_eq!(exr.width(), 48);
+    assert!(
+        exr.pixels()
+            .all(|p| p.0.iter().all(|v| v.is_finite()) && (p.0[3] == 0.0 || p.0[3] == 1.0))
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn unknown_names_are_errors_listing_the_valid_ones() {
+    let dir = temp_dir("unknown");
+    let d = dir.to_str().unwrap();
+    let out = xtask(&["render", "--scene", "nope", "--out", d]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("quad-over-plane"));
+    let out = xtask(&[
+        "render",
+        "--scene",
+        "bunny",
+        "--technique",
+        "nope",
+        "--out",
+        d,
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("ref-64"));
+    std::fs::remove_dir_all(&dir).ok();
+}
