@@ -8,6 +8,18 @@
 //!
 //! The registry is the union of the technique crates' `presets()`: adding a preset there adds it
 //! here and to `cargo xtask conformance`, with no new code.
+//!
+//! ```
+//! use shadow_tests::conformance::{Outcome, SceneContext, SuiteConfig, run_case};
+//!
+//! let cfg = SuiteConfig { width: 32, height: 24, ref_samples: 256, extra_checks: false, ..SuiteConfig::default() };
+//! let ctx = SceneContext::new(shadow_core::scenes::builtin("quad-over-plane").unwrap(), cfg).unwrap();
+//! let preset = shadow_tests::preset("ref-64").unwrap();
+//! match run_case(&preset, &ctx) {
+//!     Outcome::Ran(report) => assert!(report.metrics.rmse < 0.05),
+//!     other => panic!("{other:?}"),
+//! }
+//! ```
 
 #![deny(missing_docs)]
 

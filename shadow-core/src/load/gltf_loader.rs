@@ -198,12 +198,7 @@ pub fn load_gltf_slice(
         });
     }
     let scene = builder.build()?;
-    if scene.dropped_degenerate() > 0 {
-        warnings.push(format!(
-            "{} zero-area triangles dropped",
-            scene.dropped_degenerate()
-        ));
-    }
+    super::dropped_warning(&scene, &mut warnings);
     Ok(SceneSetup {
         name: name.to_string(),
         scene: Arc::new(scene),

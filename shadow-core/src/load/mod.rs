@@ -139,6 +139,16 @@ impl SceneSetup {
     }
 }
 
+/// The warning a loader gives when it dropped zero-area triangles.
+pub(crate) fn dropped_warning(scene: &TriangleScene, warnings: &mut Vec<String>) {
+    if scene.dropped_degenerate() > 0 {
+        warnings.push(format!(
+            "{} zero-area triangles dropped",
+            scene.dropped_degenerate()
+        ));
+    }
+}
+
 /// Loads a scene file by extension (`.gltf`, `.glb`, `.obj`).
 ///
 /// # Errors

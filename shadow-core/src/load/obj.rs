@@ -39,12 +39,7 @@ pub fn load_obj_slice(
     b.push_mesh(MeshDesc::new(positions, triangles))?;
     let scene: TriangleScene = b.build()?;
     let mut warnings = Vec::new();
-    if scene.dropped_degenerate() > 0 {
-        warnings.push(format!(
-            "{} zero-area triangles dropped",
-            scene.dropped_degenerate()
-        ));
-    }
+    super::dropped_warning(&scene, &mut warnings);
     Ok(SceneSetup {
         name: name.to_string(),
         scene: Arc::new(scene),

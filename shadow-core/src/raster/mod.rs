@@ -120,7 +120,8 @@ impl RasterView {
         Ok(())
     }
 
-    fn extents(&self) -> (f32, f32, f32, f32, f32, bool) {
+    /// `(left, right, bottom, top, near, is_perspective)`.
+    pub(crate) fn extents(&self) -> (f32, f32, f32, f32, f32, bool) {
         match self.projection {
             Projection::Perspective {
                 left,

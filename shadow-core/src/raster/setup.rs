@@ -3,7 +3,7 @@
 
 use glam::{DVec2, Vec3};
 
-use super::{Projection, RasterView};
+use super::RasterView;
 
 /// A screen-space triangle ready for scan conversion.
 #[derive(Debug, Clone)]
@@ -51,22 +51,7 @@ impl ScreenTriangle {
 
 /// Clips a view-space triangle against the near plane and returns up to two screen triangles.
 pub(super) fn setup_triangle(v: [Vec3; 3], view: &RasterView) -> Vec<ScreenTriangle> {
-    let (l, r, b, t, near, persp) = match view.projection {
-        Projection::Perspective {
-            left,
-            right,
-            bottom,
-            top,
-            near,
-        } => (left, right, bottom, top, near, true),
-        Projection::Orthographic {
-            left,
-            right,
-            bottom,
-            top,
-            near,
-        } => (left, right, bottom, top, near, false),
-    };
+    let (l, r, b, t, near, persp) = view.extents();
     // Depth d = -z; keep d >= near (Sutherland-Hodgman on one plane), in f64.
     let pts: Vec<glam::DVec3> = v.iter().map(|p| p.as_dvec3()).collect();
     let near = near as f64;
