@@ -52,6 +52,14 @@ struct Scratch {
     candidates: Vec<u32>,
 }
 
+/// What a receiver's beam found.
+struct ReceiverBeam {
+    origin: Vec3,
+    mode: BeamResult,
+    light_above: bool,
+    counts: Counts,
+}
+
 /// Work counters of one receiver (or a row of them).
 #[derive(Default, Clone, Copy)]
 struct Counts {
@@ -60,6 +68,7 @@ struct Counts {
     beam_clear: u64,
     beam_candidates: u64,
     beam_fallback: u64,
+    unsampled: u64,
 }
 
 impl Counts {
@@ -69,6 +78,7 @@ impl Counts {
         self.beam_clear += o.beam_clear;
         self.beam_candidates += o.beam_candidates;
         self.beam_fallback += o.beam_fallback;
+        self.unsampled += o.unsampled;
     }
 }
 
@@ -245,24 +255,19 @@ impl Reference {
         Ok(out)
     }
 
-    /// Visibility of each light sample from view sample `s` (transmittance in [0, 1]), and the
-    /// number of rays cast.
-    fn sample_visibility(
+    /// The beam of one receiver (when the light is planar and there are enough samples to
+    /// share it): its robust origin and what a traversal of the BVH2 with it found.
+    fn receiver_beam(
         &self,
         p: &Prepared,
         s: &ViewSample,
-        samples: &[LightSample],
+        samples: usize,
         scratch: &mut Scratch,
-    ) -> Counts {
-        let vis = &mut scratch.vis;
-        vis.clear();
-        let mut counts = Counts::default();
+    ) -> ReceiverBeam {
         let origin = p.offset.offset(s.position, s.geometric_normal);
-        // One beam per receiver when there are enough samples to share it.
+        let mut counts = Counts::default();
         let beam = match p.quad {
-            Some(q) if self.beam && samples.len() >= BEAM_MIN_SAMPLES => {
-                Beam::new(origin, q, p.beam_eps)
-            }
+            Some(q) if self.beam && samples >= BEAM_MIN_SAMPLES => Beam::new(origin, q, p.beam_eps),
             _ => None,
         };
         let mode = match beam {
@@ -278,6 +283,35 @@ impl Reference {
             (true, BeamResult::Candidates(_)) => counts.beam_candidates = 1,
             (true, BeamResult::TooMany) => counts.beam_fallback = 1,
         }
+        // The whole light (its quad, by convexity) above the tangent plane from both the
+        // surface point and the offset origin: no sample is below the horizon.
+        let n = s.geometric_normal;
+        let light_above = p.quad.is_some_and(|q| {
+            q.iter()
+                .all(|c| (*c - s.position).dot(n) > 0.0 && (*c - origin).dot(n) > 0.0)
+        });
+        ReceiverBeam {
+            origin,
+            mode,
+            light_above,
+            counts,
+        }
+    }
+
+    /// Visibility of each light sample from view sample `s` (transmittance in [0, 1]), and the
+    /// work done.
+    fn sample_visibility(
+        &self,
+        p: &Prepared,
+        s: &ViewSample,
+        rb: &ReceiverBeam,
+        samples: &[LightSample],
+        scratch: &mut Scratch,
+    ) -> Counts {
+        let vis = &mut scratch.vis;
+        vis.clear();
+        let mut counts = rb.counts;
+        let (origin, mode) = (rb.origin, rb.mode);
         let cands = &scratch.candidates;
         let mut last = u32::MAX;
         for y in samples {
@@ -339,7 +373,8 @@ impl Reference {
                     continue;
                 };
                 self.pixel_samples(p.light.as_ref(), s.pixel, &mut units, &mut samples);
-                self.sample_visibility(p, &s, &samples, &mut scratch);
+                let rb = self.receiver_beam(p, &s, samples.len(), &mut scratch);
+                self.sample_visibility(p, &s, &rb, &samples, &mut scratch);
                 let vis = &scratch.vis;
                 let albedo = p.scene.albedo(s.triangle as usize);
                 let light: &dyn AreaLight = if self.source == SampleSource::Hard {
@@ -508,11 +543,24 @@ impl ShadowTechnique for Reference {
                         let Some(s) = view.get(row * w + x) else {
                             continue;
                         };
-                        self.pixel_samples(p.light.as_ref(), s.pixel, &mut units, &mut samples);
-                        let c = self.sample_visibility(p, &s, &samples, &mut scratch);
+                        let rb = self.receiver_beam(p, &s, n as usize, &mut scratch);
+                        let c = if rb.mode == BeamResult::Clear && rb.light_above && !textured {
+                            // Fully lit with the whole light above the horizon: every sample
+                            // is visible, so none needs to be generated.
+                            scratch.vis.clear();
+                            scratch.vis.resize(n as usize, 1.0);
+                            Counts {
+                                rays: n as u64,
+                                unsampled: 1,
+                                ..rb.counts
+                            }
+                        } else {
+                            self.pixel_samples(p.light.as_ref(), s.pixel, &mut units, &mut samples);
+                            self.sample_visibility(p, &s, &rb, &samples, &mut scratch)
+                        };
                         let vis = &scratch.vis;
                         r.rays += c.rays;
-                        r.below += samples.len() as u64 - c.rays;
+                        r.below += n as u64 - c.rays;
                         r.counts.add(&c);
                         let sum: f64 = vis.iter().map(|&v| v as f64).sum();
                         r.v[x] = (sum / n as f64) as f32;
@@ -568,6 +616,7 @@ impl ShadowTechnique for Reference {
             stats.add("pixels-beam-clear", r.counts.beam_clear);
             stats.add("pixels-beam-candidates", r.counts.beam_candidates);
             stats.add("pixels-beam-fallback", r.counts.beam_fallback);
+            stats.add("pixels-lit-without-samples", r.counts.unsampled);
         }
         stats.add("pixels", view.valid_count() as u64);
         stats.add("threads", rayon::current_num_threads() as u64);

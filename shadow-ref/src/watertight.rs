@@ -4,18 +4,17 @@
 //! f64 fallback when one is zero. A ray through an edge or vertex shared by two triangles hits
 //! at least one of them: no leak through closed meshes.
 
-use glam::{DVec3, Vec3A};
+use glam::{DVec3, Mat3A, Vec3A};
 
-/// Per-ray constants of the test (section 3 of the paper).
+/// Per-ray constants of the test (section 3 of the paper). The permutation (`kx, ky, kz`) and
+/// the shear are folded into one matrix, so each vertex is transformed with one SIMD
+/// matrix-vector product; every vertex's sheared coordinates still depend only on the vertex and
+/// the ray, which is what makes the test watertight.
 #[derive(Debug, Clone, Copy)]
 pub struct ShearedRay {
     origin: Vec3A,
-    kx: usize,
-    ky: usize,
-    kz: usize,
-    sx: f32,
-    sy: f32,
-    sz: f32,
+    /// Maps `v - origin` to `(v[kx] - sx v[kz], v[ky] - sy v[kz], sz v[kz])`.
+    shear: Mat3A,
 }
 
 impl ShearedRay {
@@ -34,14 +33,15 @@ impl ShearedRay {
         if dir[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
+        let (sx, sy, sz) = (dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
+        // Column c holds the coefficients of input component c in the three outputs.
+        let mut cols = [Vec3A::ZERO; 3];
+        cols[kx].x = 1.0;
+        cols[ky].y = 1.0;
+        cols[kz] = Vec3A::new(-sx, -sy, sz);
         Self {
             origin,
-            kx,
-            ky,
-            kz,
-            sx: dir[kx] / dir[kz],
-            sy: dir[ky] / dir[kz],
-            sz: 1.0 / dir[kz],
+            shear: Mat3A::from_cols(cols[0], cols[1], cols[2]),
         }
     }
 
@@ -56,16 +56,10 @@ impl ShearedRay {
         t_min: f32,
         t_max: f32,
     ) -> Option<f32> {
-        let (kx, ky, kz) = (self.kx, self.ky, self.kz);
-        let a = v0 - self.origin;
-        let b = v1 - self.origin;
-        let c = v2 - self.origin;
-        let ax = a[kx] - self.sx * a[kz];
-        let ay = a[ky] - self.sy * a[kz];
-        let bx = b[kx] - self.sx * b[kz];
-        let by = b[ky] - self.sy * b[kz];
-        let cx = c[kx] - self.sx * c[kz];
-        let cy = c[ky] - self.sy * c[kz];
+        let a = self.shear * (v0 - self.origin);
+        let b = self.shear * (v1 - self.origin);
+        let c = self.shear * (v2 - self.origin);
+        let (ax, ay, bx, by, cx, cy) = (a.x, a.y, b.x, b.y, c.x, c.y);
         let mut u = cx * by - cy * bx;
         let mut v = ax * cy - ay * cx;
         let mut w = bx * ay - by * ax;
@@ -85,10 +79,7 @@ impl ShearedRay {
         if det == 0.0 {
             return None;
         }
-        let az = self.sz * a[kz];
-        let bz = self.sz * b[kz];
-        let cz = self.sz * c[kz];
-        let t_scaled = u * az + v * bz + w * cz;
+        let t_scaled = u * a.z + v * b.z + w * c.z;
         // Compare t_scaled / det against the range without dividing (sign-aware).
         let (t_scaled, det) = if det < 0.0 {
             (-t_scaled, -det)
