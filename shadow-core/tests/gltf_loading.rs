@@ -453,3 +453,87 @@ fn emissive_sphere_becomes_a_sphere_light() {
     }
     assert!(setup.camera.is_none());
 }
+
+#[test]
+fn concave_planar_emitter_becomes_a_polygon_light_and_holes_are_refused() {
+    let mut w = Writer::default();
+    let grey = w.material(json!({}));
+    let lamp = w.material(json!({"emissiveFactor": [1.0, 1.0, 1.0]}));
+    let (fp, fi) = square(3.0);
+    w.mesh("floor", &fp, &fi, None, grey);
+    // An L of three unit squares in the plane y = 0 (moved to y = 2 by its node), wound so the
+    // normal points down.
+    let l: Vec<Vec3> = [
+        (0.0, 0.0),
+        (1.0, 0.0),
+        (2.0, 0.0),
+        (0.0, 1.0),
+        (1.0, 1.0),
+        (2.0, 1.0),
+        (0.0, 2.0),
+        (1.0, 2.0),
+    ]
+    .iter()
+    .map(|&(x, z)| Vec3::new(x, 0.0, z))
+    .collect();
+    let quads = [[0u32, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6]];
+    let idx: Vec<u32> = quads
+        .iter()
+        .flat_map(|q| [q[0], q[1], q[2], q[0], q[2], q[3]])
+        .collect();
+    w.mesh("l-lamp", &l, &idx, None, lamp);
+    let doc = w.document(
+        json!([{"mesh": 0}, {"mesh": 1, "translation": [0.0, 2.0, 0.0]}]),
+        json!([]),
+    );
+    let setup = load(&doc).unwrap();
+    let light = &setup.lights[0];
+    assert_eq!(light.kind(), LightKind::Polygon);
+    assert!((light.area() - 3.0).abs() < 1e-5);
+    match light.geometry() {
+        LightGeometry::Polygon { outline, normal } => {
+            assert_eq!(
+                outline.len(),
+                6,
+                "collinear boundary vertices are removed: {outline:?}"
+            );
+            assert!(outline.iter().all(|p| (p.y - 2.0).abs() < 1e-6));
+            assert!((normal.y.abs() - 1.0).abs() < 1e-6);
+        }
+        g => panic!("expected a polygon, got {g:?}"),
+    }
+
+    // A square ring (a hole in the middle) is refused with a reason naming the mesh.
+    let mut w = Writer::default();
+    let grey = w.material(json!({}));
+    let lamp = w.material(json!({"emissiveFactor": [1.0, 1.0, 1.0]}));
+    w.mesh("floor", &fp, &fi, None, grey);
+    let mut ring = Vec::new();
+    for j in 0..4 {
+        for i in 0..4 {
+            ring.push(Vec3::new(i as f32, 0.0, j as f32));
+        }
+    }
+    let mut idx = Vec::new();
+    for j in 0..3u32 {
+        for i in 0..3u32 {
+            if i == 1 && j == 1 {
+                continue; // the hole
+            }
+            let a = j * 4 + i;
+            idx.extend([a, a + 1, a + 5, a, a + 5, a + 4]);
+        }
+    }
+    w.mesh("ring-lamp", &ring, &idx, None, lamp);
+    let doc = w.document(
+        json!([{"mesh": 0}, {"mesh": 1, "translation": [0.0, 2.0, 0.0]}]),
+        json!([]),
+    );
+    match load(&doc) {
+        Err(LoadError::Unsupported { mesh, reason }) => {
+            assert_eq!(mesh, "ring-lamp");
+            assert!(reason.contains("boundary loops"), "{reason}");
+        }
+        other => panic!("expected Unsupported, got {other:?}"),
+    }
+}
