@@ -117,7 +117,7 @@ impl OcclusionBvh {
                 prim_count: n.prim_count,
                 first: n.first_index,
             })
-            .collect();
+            .collect::<Vec<_>>();
         let beam_prims = bvh2.primitive_indices.clone();
         let by_id: Vec<[Vec3A; 3]> = (0..scene.triangle_count())
             .map(|t| scene.triangle(t).map(Vec3A::from))
@@ -164,11 +164,25 @@ impl OcclusionBvh {
         })
     }
 
-    /// The id of a triangle (not `ignore`) strictly between `origin` and `origin + dir * t_max`,
-    /// if any: the occlusion query that also says by what.
-    pub fn occluder(&self, origin: Vec3, dir: Vec3, t_max: f32, ignore: u32) -> Option<u32> {
+    /// The occlusion query with a shadow cache: `last` (a scene triangle id, or `u32::MAX`) is
+    /// tested first, and updated to the blocking triangle when the traversal finds one.
+    /// Neighbouring samples of a receiver are usually blocked by the same triangle.
+    pub fn occluded_cached(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        ignore: u32,
+        last: &mut u32,
+    ) -> bool {
         let (o, d) = ray_parts(origin, dir);
         let sheared = ShearedRay::new(o, d);
+        if *last != u32::MAX {
+            let [a, b, c] = self.by_id[*last as usize];
+            if sheared.intersect(a, b, c, 0.0, t_max).is_some() {
+                return true;
+            }
+        }
         let ray = Ray::new(o, d, 0.0, t_max);
         let found = std::cell::Cell::new(u32::MAX);
         let miss = self.bvh.ray_traverse_miss(ray, |_, id| {
@@ -185,16 +199,10 @@ impl OcclusionBvh {
                 None => f32::INFINITY,
             }
         });
-        (!miss).then(|| found.get())
-    }
-
-    /// True when triangle `id` blocks the segment.
-    pub fn blocks(&self, id: u32, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
-        let (o, d) = ray_parts(origin, dir);
-        let [a, b, c] = self.by_id[id as usize];
-        ShearedRay::new(o, d)
-            .intersect(a, b, c, 0.0, t_max)
-            .is_some()
+        if !miss {
+            *last = found.get();
+        }
+        !miss
     }
 
     /// Product of `1 - opacity` over every distinct triangle strictly between `origin` and

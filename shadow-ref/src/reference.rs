@@ -339,17 +339,13 @@ impl Reference {
                 (BeamResult::TooMany, false) => {
                     // Shadow cache: the triangle that blocked the previous segment of this
                     // receiver is tried first; neighbouring samples usually share it.
-                    if last != u32::MAX && p.bvh.blocks(last, origin, dir, t_max) {
+                    counts.traversed += 1;
+                    if p.bvh
+                        .occluded_cached(origin, dir, t_max, s.triangle, &mut last)
+                    {
                         0.0
                     } else {
-                        counts.traversed += 1;
-                        match p.bvh.occluder(origin, dir, t_max, s.triangle) {
-                            Some(id) => {
-                                last = id;
-                                0.0
-                            }
-                            None => 1.0,
-                        }
+                        1.0
                     }
                 }
             });
@@ -612,7 +608,7 @@ impl ShadowTechnique for Reference {
             bits.extend_from_slice(&r.bits);
             stats.add("occlusion-rays", r.rays);
             stats.add("samples-below-horizon", r.below);
-            stats.add("rays-traversed", r.counts.traversed);
+            stats.add("rays-single", r.counts.traversed);
             stats.add("pixels-beam-clear", r.counts.beam_clear);
             stats.add("pixels-beam-candidates", r.counts.beam_candidates);
             stats.add("pixels-beam-fallback", r.counts.beam_fallback);
