@@ -206,8 +206,8 @@ impl OcclusionBvh {
     }
 
     /// Product of `1 - opacity` over every distinct triangle strictly between `origin` and
-    /// `origin + dir * t_max`, `ignore` excepted (0 as soon as an opaque triangle is crossed), and the number of
-    /// surfaces crossed.
+    /// `origin + dir * t_max`, `ignore` excepted (0 once an opaque triangle is crossed), and the
+    /// number of surfaces crossed.
     pub fn transmittance(&self, origin: Vec3, dir: Vec3, t_max: f32, ignore: u32) -> (f32, u32) {
         let (o, d) = ray_parts(origin, dir);
         let sheared = ShearedRay::new(o, d);

@@ -12,8 +12,15 @@
 //!
 //! A sample below the receiver's tangent plane (camera-facing geometric normal) is occluded
 //! without a ray; the receiver's own triangle is never an occluder of its samples (it cannot be:
-//! the sample is above its plane), which keeps the origin offset small. Pixels are independent and their samples come from a counter-based hash, so
-//! the output is identical whatever the thread count.
+//! the sample is above its plane), which keeps the origin offset small. Pixels are independent
+//! and their samples come from a counter-based hash, so the output is identical whatever the
+//! thread count.
+//!
+//! Work a receiver does not need is skipped, with identical answers: for planar lights one
+//! pyramid traversal of the BVH2 per receiver ([`crate::beam`]) proves most receivers fully
+//! lit (their samples are then not even generated when the whole light is above their horizon)
+//! or yields a short candidate list; only receivers whose beam holds many triangles query the
+//! CWBVH segment by segment, last occluder first.
 
 use std::sync::Arc;
 
