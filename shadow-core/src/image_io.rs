@@ -100,6 +100,46 @@ pub fn write_normal_exr(path: &Path, view: &ViewSamples) -> Result<(), ImageErro
     write_aov(path, view, view.geometric_normals())
 }
 
+/// Writes any per-pixel RGB quantity of `view` (direct illumination, for instance) as float32
+/// EXR, A = validity.
+///
+/// # Errors
+/// [`ImageError::Size`] when `data` does not have one value per pixel; write failures.
+pub fn write_rgb_exr(path: &Path, view: &ViewSamples, data: &[Vec3]) -> Result<(), ImageError> {
+    if data.len() != view.len() {
+        return Err(ImageError::Size);
+    }
+    write_aov(path, view, data)
+}
+
+/// Writes per-pixel linear RGB radiance as an 8-bit sRGB PNG, scaled so the brightest valid
+/// pixel is white.
+///
+/// # Errors
+/// [`ImageError::Size`] when `data` does not have one value per pixel; write failures.
+pub fn write_radiance_png(
+    path: &Path,
+    view: &ViewSamples,
+    data: &[Vec3],
+) -> Result<(), ImageError> {
+    if data.len() != view.len() {
+        return Err(ImageError::Size);
+    }
+    let m = (0..view.len())
+        .filter(|&i| view.is_valid(i))
+        .map(|i| data[i].max_element())
+        .filter(|v| v.is_finite())
+        .fold(0.0f32, f32::max);
+    let scale = if m > 0.0 { 1.0 / m } else { 1.0 };
+    save_rgb8(path, view.width(), view.height(), |i| {
+        if view.is_valid(i) {
+            data[i] * scale
+        } else {
+            BACKGROUND
+        }
+    })
+}
+
 fn write_aov(path: &Path, view: &ViewSamples, data: &[Vec3]) -> Result<(), ImageError> {
     save_rgba32(path, view.width(), view.height(), |i| {
         if view.is_valid(i) {

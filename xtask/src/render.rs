@@ -6,8 +6,8 @@ use std::time::Instant;
 use clap::Args;
 use serde_json::json;
 use shadow_core::image_io::{
-    write_normal_exr, write_position_exr, write_shaded_png, write_visibility_exr,
-    write_visibility_png,
+    write_normal_exr, write_position_exr, write_radiance_png, write_rgb_exr, write_shaded_png,
+    write_visibility_exr, write_visibility_png,
 };
 use shadow_core::prelude::*;
 
@@ -36,6 +36,10 @@ pub struct RenderArgs {
     /// Seed of the technique's sampling.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Also write the reference's direct illumination (DCS eq. 6, diffuse albedo, the same
+    /// sample count: `--samples`, default 256) as `direct.exr` and `direct.png`.
+    #[arg(long)]
+    direct: bool,
     /// Output directory.
     #[arg(long)]
     out: PathBuf,
@@ -47,8 +51,8 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         Some(t) => Some(resolve_technique(t, a.samples, a.seed)?),
         None => None,
     };
-    if a.technique.is_none() && a.samples.is_some() {
-        return Err("--samples needs --technique".into());
+    if a.technique.is_none() && a.samples.is_some() && !a.direct {
+        return Err("--samples needs --technique or --direct".into());
     }
     let height = a.height.unwrap_or_else(|| match setup.aspect {
         Some(r) if r > 0.0 && r.is_finite() => ((a.width as f32 / r).round() as u32).max(1),
@@ -108,6 +112,19 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         if let Some(r) = rays_per_second_per_thread(&est.stats) {
             stats["occlusion_rays_per_second_per_thread"] = json!(r);
         }
+    }
+    if a.direct {
+        pb.set_message("direct illumination");
+        let mut r = shadow_ref::Reference::stratified(a.samples.unwrap_or(256), a.seed)
+            .map_err(|e| e.to_string())?;
+        let t0 = Instant::now();
+        r.prepare(setup.scene.clone(), setup.lights[0].clone())
+            .map_err(|e| e.to_string())?;
+        let direct = r.direct_illumination(&view).map_err(|e| e.to_string())?;
+        write_rgb_exr(&a.out.join("direct.exr"), &view, &direct).map_err(|e| e.to_string())?;
+        write_radiance_png(&a.out.join("direct.png"), &view, &direct).map_err(|e| e.to_string())?;
+        stats["direct_illumination"] =
+            json!({"samples": a.samples.unwrap_or(256), "seconds": t0.elapsed().as_secs_f64()});
     }
     pb.finish_and_clear();
     write_json(&a.out.join("stats.json"), &stats)?;

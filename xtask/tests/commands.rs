@@ -86,6 +86,32 @@ fn render_writes_view_samples_and_visibility() {
         exr.pixels()
             .all(|p| p.0.iter().all(|v| v.is_finite()) && (p.0[3] == 0.0 || p.0[3] == 1.0))
     );
+    // Direct illumination from the reference: finite, non-negative, black on background.
+    let out = xtask(&[
+        "render",
+        "--scene",
+        "quad-over-plane",
+        "--direct",
+        "--samples",
+        "16",
+        "--width",
+        "40",
+        "--out",
+        d,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let direct = image::open(dir.join("direct.exr")).unwrap().to_rgba32f();
+    assert!(
+        direct
+            .pixels()
+            .all(|p| p.0.iter().all(|v| v.is_finite() && *v >= 0.0))
+    );
+    assert!(direct.pixels().any(|p| p.0[0] > 0.0));
+    assert!(dir.join("direct.png").is_file());
     std::fs::remove_dir_all(&dir).ok();
 }
 
