@@ -180,34 +180,33 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
                         .metrics
                         .penumbra_rmse
                         .map_or("-".to_string(), |v| format!("{v:.4}"));
-                    println!(
-                        "{:<12} {:<22} {:>8.4} {:>8} {:>+8.4} {:>6.3} {:>7.4} {:>28} {:>9}  {}",
-                        p.name,
-                        scene,
-                        r.metrics.rmse,
+                    let cells = [
+                        p.name.to_string(),
+                        scene.to_string(),
+                        format!("{:.4}", r.metrics.rmse),
                         pen,
-                        r.metrics.bias,
-                        r.metrics.max_abs,
-                        r.metrics.share_over_0_1,
+                        format!("{:+.4}", r.metrics.bias),
+                        format!("{:.3}", r.metrics.max_abs),
+                        format!("{:.4}", r.metrics.share_over_0_1),
                         phases,
                         speedup,
-                        status
-                    );
-                    writeln!(
-                        md,
-                        "| {} | {} | {:.4} | {} | {:+.4} | {:.3} | {:.4} | {} | {} | {} |",
-                        p.name,
-                        scene,
-                        r.metrics.rmse,
-                        pen,
-                        r.metrics.bias,
-                        r.metrics.max_abs,
-                        r.metrics.share_over_0_1,
-                        phases,
-                        speedup,
-                        status
-                    )
-                    .ok();
+                        status,
+                    ];
+                    let widths = [12, 22, 8, 8, 8, 6, 7, 28, 9, 0];
+                    let line: Vec<String> = cells
+                        .iter()
+                        .zip(widths)
+                        .enumerate()
+                        .map(|(k, (c, w))| {
+                            if k < 2 {
+                                format!("{c:<w$}")
+                            } else {
+                                format!("{c:>w$}")
+                            }
+                        })
+                        .collect();
+                    println!("{}", line.join(" "));
+                    writeln!(md, "| {} |", cells.join(" | ")).ok();
                     let mut row = serde_json::to_value(&*r).map_err(|e| e.to_string())?;
                     row["status"] = json!(if r.passed() { "ok" } else { "fail" });
                     row["speedup_at_equal_error"] =
