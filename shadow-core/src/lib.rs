@@ -44,6 +44,7 @@ pub mod image_io;
 pub mod light;
 pub mod load;
 pub mod metrics;
+pub mod offset;
 pub mod preset;
 pub mod procedural;
 pub mod raster;

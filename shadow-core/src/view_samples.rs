@@ -19,6 +19,7 @@ pub struct ViewSamples {
     width: u32,
     height: u32,
     camera_position: Vec3,
+    view: RasterView,
     position: Vec<Vec3>,
     geometric_normal: Vec<Vec3>,
     shading_normal: Vec<Vec3>,
@@ -128,6 +129,7 @@ impl ViewSamples {
             width: w,
             height: h,
             camera_position,
+            view: *view,
             position,
             geometric_normal,
             shading_normal,
@@ -155,6 +157,19 @@ impl ViewSamples {
     /// Position of the camera (ray origin of perspective views).
     pub fn camera_position(&self) -> Vec3 {
         self.camera_position
+    }
+    /// The camera projection the samples were rendered with (techniques that rasterize in the
+    /// camera's image, such as DCS's shadow-volume and wedge passes, need it).
+    pub fn raster_view(&self) -> &RasterView {
+        &self.view
+    }
+    /// The eye point of a perspective view, `None` for an orthographic one.
+    pub fn eye(&self) -> Option<Vec3> {
+        matches!(
+            self.view.projection,
+            crate::raster::Projection::Perspective { .. }
+        )
+        .then_some(self.camera_position)
     }
     /// True when pixel `i` (row-major) sees a surface.
     pub fn is_valid(&self, i: usize) -> bool {

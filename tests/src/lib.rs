@@ -33,6 +33,7 @@ use shadow_core::preset::Preset;
 pub fn registry() -> Vec<Preset> {
     let mut all = Vec::new();
     all.extend(shadow_ref::presets());
+    all.extend(shadow_dcs::presets());
     all
 }
 

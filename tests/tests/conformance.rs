@@ -77,8 +77,17 @@ fn every_preset_against_the_closed_form() {
                 "{:<12} vs closed form: rmse {:.5} max {:.4}",
                 p.name, m.rmse, m.max_abs
             );
+            // A sample-based technique's budget is against the reference on its own samples;
+            // against the closed form it may add that reference's sampling error.
+            let (noise_rmse, noise_max) = if r.same_samples {
+                let n =
+                    shadow_core::metrics::compare(&masked(&r.reference, &mask), &exact).unwrap();
+                (n.rmse, n.max_abs)
+            } else {
+                (0.0, 0.0)
+            };
             assert!(
-                m.rmse <= b.rmse && m.max_abs <= b.max_abs,
+                m.rmse <= b.rmse + noise_rmse && m.max_abs <= b.max_abs + noise_max,
                 "{} against the closed form: {m:?}",
                 p.name
             );

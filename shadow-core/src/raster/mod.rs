@@ -121,7 +121,7 @@ impl RasterView {
     }
 
     /// `(left, right, bottom, top, near, is_perspective)`.
-    pub(crate) fn extents(&self) -> (f32, f32, f32, f32, f32, bool) {
+    pub fn extents(&self) -> (f32, f32, f32, f32, f32, bool) {
         match self.projection {
             Projection::Perspective {
                 left,
@@ -161,6 +161,24 @@ impl RasterView {
     /// Linear depth of a world point in this view.
     pub fn depth_of(&self, p: Vec3) -> f32 {
         -self.view_from_world.transform_point3(p).z
+    }
+}
+
+/// Calls `f(x, y)` for every pixel whose centre a world-space triangle covers in `view`, with
+/// the same near-plane clipping and top-left rule as [`rasterize`]: a pixel centre on an edge
+/// shared by two triangles is reported for exactly one of them, whatever their winding. Used by
+/// techniques that rasterize volumes into the camera image (DCS's shadow-volume quads, section
+/// 4.1, and its wedges, section 4.2).
+pub fn for_each_covered_pixel(view: &RasterView, tri: [Vec3; 3], mut f: impl FnMut(u32, u32)) {
+    let v = tri.map(|p| view.view_from_world.transform_point3(p));
+    for st in setup_triangle(v, view) {
+        for y in st.ymin..=st.ymax {
+            for x in st.xmin..=st.xmax {
+                if st.covers(x, y) {
+                    f(x, y);
+                }
+            }
+        }
     }
 }
 

@@ -28,8 +28,8 @@ fn edge(a: DVec2, b: DVec2, p: DVec2) -> f64 {
 }
 
 impl ScreenTriangle {
-    /// Linear depth at the centre of pixel `(x, y)` when covered.
-    pub fn depth_at_center(&self, x: u32, y: u32) -> Option<f32> {
+    /// Edge-function weights at the centre of pixel `(x, y)` when it is covered (top-left rule).
+    fn weights_at(&self, x: u32, y: u32) -> Option<[f64; 3]> {
         let c = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
         let mut w = [0.0; 3];
         for i in 0..3 {
@@ -41,6 +41,17 @@ impl ScreenTriangle {
             // Edge i -> i+1 weighs the opposite vertex i+2.
             w[(i + 2) % 3] = e;
         }
+        Some(w)
+    }
+
+    /// True when the centre of pixel `(x, y)` is covered (top-left rule).
+    pub fn covers(&self, x: u32, y: u32) -> bool {
+        self.weights_at(x, y).is_some()
+    }
+
+    /// Linear depth at the centre of pixel `(x, y)` when covered.
+    pub fn depth_at_center(&self, x: u32, y: u32) -> Option<f32> {
+        let w = self.weights_at(x, y)?;
         let (b0, b1, b2) = (w[0] / self.area, w[1] / self.area, w[2] / self.area);
         let zi = b0 * self.z[0] + b1 * self.z[1] + b2 * self.z[2];
         let d = if self.perspective { 1.0 / zi } else { zi };

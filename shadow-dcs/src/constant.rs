@@ -1,0 +1,248 @@
+//! The integration constant (DCS section 4.1): the depth complexity from each view sample `p`
+//! toward the light centre `c`, computed as in a shadow-volume renderer from the silhouettes
+//! alone, never by casting a ray from `p` against the triangles.
+//!
+//! The shadow-volume quad of a silhouette edge `(a, b)` is the part of the plane through `c`
+//! and the edge beyond the edge, away from `c`. The depth complexity `D(x, c)` of a point `x`
+//! changes only when `x` crosses such a quad (the segment `x c` sweeps across the edge), by the
+//! edge's weight `k_e` (`SceneEdge::sweep_weight`), or when `x` crosses a surface.
+//! The segment from the eye to a visible point crosses no surface, so (z-pass):
+//!
+//! `D(p, c) = D(eye, c) + sum of k_e over the quads the eye segment crosses before p`.
+//!
+//! Quads are scan-converted into the camera image with the core rasterizer's coverage rule (a
+//! pixel on an edge shared by two quads is counted once); at each covered pixel an exact
+//! orientation test decides whether the quad's plane lies between the eye and the view sample
+//! (the depth test of a stencil shadow volume). `D(eye, c)` is the only ray-cast value: one
+//! segment per frame. Quads end at a radius from `c` beyond every view sample and the eye, with
+//! the far vertices shared between neighbouring quads, and the camera's near plane is moved
+//! to almost zero, so no crossing is lost to clipping.
+
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+use shadow_core::raster::{Projection, RasterView, for_each_covered_pixel};
+use shadow_core::scene::Scene;
+
+use crate::edges::{SceneEdge, ray_hits_triangle};
+
+/// Far vertices lie at this many times the largest eye or sample distance from `c`: a quad's
+/// far edge is a chord, and it stays beyond every view sample unless the edge subtends more
+/// than 178 degrees from the light centre (an occluder touching the centre).
+const FAR_FACTOR: f64 = 64.0;
+
+/// `D(eye, c)`: the weighted crossings of the segment from the eye to the light centre, with the
+/// faces counted from the light's side (front faces of one-sided meshes, every face of
+/// two-sided ones).
+pub(crate) fn eye_constant(scene: &dyn Scene, edges_units: u32, eye: Vec3, c: Vec3) -> i64 {
+    let (o, target) = (eye.as_dvec3(), c.as_dvec3());
+    let d = target - o;
+    let topo = scene.topology();
+    let opac = scene.opacities();
+    let semi = scene.has_semi_opaque();
+    let mut total = 0i64;
+    for t in 0..scene.triangle_count() {
+        let [a, b, cc] = scene.triangle(t).map(|v| v.as_dvec3());
+        if !ray_hits_triangle(o, d, a, b, cc, 1.0) {
+            continue;
+        }
+        let comp = &topo.components()[topo.component_of(t)];
+        let one_sided = comp.closed && comp.consistently_oriented;
+        let front_from_light = (b - a).cross(cc - a).dot(target - a) > 0.0;
+        if one_sided && !front_from_light {
+            continue;
+        }
+        total += if semi {
+            (opac[t].clamp(0.0, 1.0) * edges_units as f32).ceil() as i64
+        } else {
+            1
+        };
+    }
+    total
+}
+
+/// The integration constant of every pixel (0 for background), by rasterizing the
+/// shadow-volume quads of `silhouettes` (edges seen from the light centre).
+///
+/// Returns the constants and the number of quads rasterized.
+pub(crate) fn integration_constants(
+    edges: &[SceneEdge],
+    silhouettes: &[u32],
+    c: Vec3,
+    eye: Vec3,
+    eye_constant: i64,
+    view: &RasterView,
+    origins: &[Vec3],
+    valid: &[bool],
+) -> (Vec<i64>, u64) {
+    let cd = c.as_dvec3();
+    let eyed = eye.as_dvec3();
+    let reach = origins
+        .iter()
+        .zip(valid)
+        .filter(|(_, v)| **v)
+        .map(|(p, _)| (p.as_dvec3() - cd).length())
+        .fold((eyed - cd).length(), f64::max);
+    let far_radius = reach * FAR_FACTOR;
+    let far = |v: DVec3| -> Option<Vec3> {
+        let d = v - cd;
+        let l = d.length();
+        (l > 0.0).then(|| (cd + d * (far_radius / l)).as_vec3())
+    };
+    // The quads with a non-zero weight, seen from the eye.
+    let quads: Vec<([Vec3; 4], i64, [DVec3; 3], bool)> = silhouettes
+        .iter()
+        .filter_map(|&i| {
+            let e = &edges[i as usize];
+            let k = e.sweep_weight(cd, eyed, true)?;
+            if k == 0 {
+                return None;
+            }
+            let eye_side = super::edges::orient(cd, e.a, e.b, eyed);
+            if eye_side == 0.0 {
+                return None;
+            }
+            let (af, bf) = (far(e.a)?, far(e.b)?);
+            Some((
+                [e.a.as_vec3(), e.b.as_vec3(), bf, af],
+                k,
+                [cd, e.a, e.b],
+                eye_side > 0.0,
+            ))
+        })
+        .collect();
+    let near_view = near_zero(view, far_radius);
+    let w = view.width as usize;
+    let n = origins.len();
+    let sums = quads
+        .par_iter()
+        .fold(
+            || vec![0i64; n],
+            |mut acc, (q, k, plane, eye_positive)| {
+                let mut visit = |x: u32, y: u32| {
+                    let i = y as usize * w + x as usize;
+                    if !valid[i] {
+                        return;
+                    }
+                    let side =
+                        super::edges::orient(plane[0], plane[1], plane[2], origins[i].as_dvec3());
+                    if side != 0.0 && (side > 0.0) != *eye_positive {
+                        acc[i] += k;
+                    }
+                };
+                for_each_covered_pixel(&near_view, [q[0], q[1], q[2]], &mut visit);
+                for_each_covered_pixel(&near_view, [q[0], q[2], q[3]], &mut visit);
+                acc
+            },
+        )
+        .reduce(
+            || vec![0i64; n],
+            |mut a, b| {
+                for (x, y) in a.iter_mut().zip(b) {
+                    *x += y;
+                }
+                a
+            },
+        );
+    let out = sums
+        .into_iter()
+        .zip(valid)
+        .map(|(s, v)| if *v { s + eye_constant } else { 0 })
+        .collect();
+    (out, quads.len() as u64)
+}
+
+/// The camera view with its near plane moved to almost zero (perspective), so that quads
+/// crossing the eye segment just in front of the eye are not clipped away.
+fn near_zero(view: &RasterView, scale: f64) -> RasterView {
+    let mut v = *view;
+    if let Projection::Perspective { near, .. } = &mut v.projection {
+        *near = near.min((scale * 1e-9) as f32).max(f32::MIN_POSITIVE * 1e6);
+    }
+    v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::edges::{Silhouettes, scene_edges, silhouettes};
+    use crate::light_shape::LightShape;
+    use shadow_core::light::{Radiance, RectLight};
+    use shadow_core::prelude::*;
+    use shadow_core::procedural;
+
+    /// The integration constant equals the ray-cast count of faces turned away from `p` that
+    /// the segment from `p` to the light centre crosses, on closed meshes.
+    #[test]
+    fn integration_constant_matches_ray_cast_crossings_on_closed_meshes() {
+        let mut b = SceneBuilder::new();
+        for m in [
+            procedural::floor(6.0, 0.0),
+            procedural::cuboid(Vec3::new(-0.8, 0.6, -0.5), Vec3::new(0.2, 1.0, 0.4), false),
+            procedural::uv_sphere(Vec3::new(0.4, 1.6, 0.2), 0.35, 12, 18),
+            procedural::cuboid(Vec3::new(-0.3, 2.2, -0.6), Vec3::new(0.9, 2.4, 0.5), false),
+        ] {
+            b.push_mesh(MeshDesc::new(m.0, m.1)).unwrap();
+        }
+        let scene = b.build().unwrap();
+        let light = RectLight::facing(
+            Vec3::new(0.1, 4.0, 0.0),
+            Vec3::NEG_Y,
+            1.0,
+            1.0,
+            Radiance::constant(Vec3::ONE).unwrap(),
+        )
+        .unwrap();
+        let cam = Camera::look_at(
+            Vec3::new(0.0, 3.0, 6.0),
+            Vec3::new(0.0, 0.6, 0.0),
+            Vec3::Y,
+            0.9,
+        )
+        .unwrap();
+        let view = ViewSamples::render(&scene, &cam, 64, 48).unwrap();
+        let shape = LightShape::new(&light, "test").unwrap();
+        let (edges, units) = scene_edges(&scene, shape.center);
+        let sil = silhouettes(&edges, &shape, Silhouettes::Accurate);
+        let origins: Vec<Vec3> = (0..view.len())
+            .map(|i| {
+                view.get(i)
+                    .map_or(Vec3::ZERO, |s| s.position + s.geometric_normal * 1e-4)
+            })
+            .collect();
+        let valid = view.valid_mask();
+        let eye = view.eye().unwrap();
+        let eye_c = eye_constant(&scene, units, eye, shape.center);
+        let (got, quads) = integration_constants(
+            &edges,
+            &sil,
+            shape.center,
+            eye,
+            eye_c,
+            view.raster_view(),
+            &origins,
+            &valid,
+        );
+        assert!(quads > 10);
+        let c = shape.center.as_dvec3();
+        let (mut checked, mut shadowed) = (0, 0);
+        for i in 0..view.len() {
+            if !valid[i] {
+                continue;
+            }
+            let p = origins[i].as_dvec3();
+            let mut want = 0i64;
+            for t in 0..scene.triangle_count() {
+                let [a, b, cc] = scene.triangle(t).map(|v| v.as_dvec3());
+                let back = (b - a).cross(cc - a).dot(p - a) < 0.0;
+                let closed = scene.is_closed_at(t);
+                if (!closed || back) && ray_hits_triangle(p, c - p, a, b, cc, 1.0) {
+                    want += 1;
+                }
+            }
+            assert_eq!(got[i], want, "pixel {i}");
+            checked += 1;
+            shadowed += (want > 0) as u32;
+        }
+        assert!(checked > 1000 && shadowed > 100, "{checked} {shadowed}");
+    }
+}

@@ -1,0 +1,45 @@
+//! # shadow-dcs
+//!
+//! Depth complexity sampling (V. Forest, L. Barthe and M. Paulin, "Accurate Shadows by Depth
+//! Complexity Sampling", Eurographics 2008) on the CPU: the number of occluding layers between
+//! each view sample and each light sample, integrated from silhouette edges instead of cast
+//! rays, then turned into the visibility coefficient (eq. 1), its textured-light form (eq. 2)
+//! and the direct illumination (eq. 6).
+//!
+//! * [`edges`]: scene edges, weights and accurate or standard silhouette detection (section 4.1);
+//! * [`constant`]: the integration constant by the shadow-volume step (section 4.1);
+//! * [`wedges`]: the view samples inside each penumbra wedge (section 4.2);
+//! * [`coverage`]: the light samples an edge covers, exactly (Algorithm 1, Fig. 2);
+//! * [`discrete`]: the sector and line tables of section 7.3 (Fig. 8);
+//! * [`counters`]: packed counters with overflow detection (sections 4.3, 4.4, 5.3);
+//! * [`technique`]: the [`Dcs`] technique; [`presets`] registers its configurations.
+//!
+//! ```
+//! use shadow_core::prelude::*;
+//! use shadow_dcs::Dcs;
+//!
+//! let setup = shadow_core::scenes::builtin("quad-over-plane").unwrap();
+//! let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 32, 24).unwrap();
+//! let mut dcs = Dcs::new(16, SamplingStrategy::Stratified, 1).unwrap();
+//! dcs.prepare(setup.scene.clone(), setup.lights[0].clone()).unwrap();
+//! let est = dcs.estimate(&view).unwrap();
+//! assert!(est.stats.counter("wedge-pairs") > 0);
+//! ```
+
+#![deny(missing_docs)]
+
+mod budgets;
+pub mod constant;
+pub mod counters;
+pub mod coverage;
+pub mod discrete;
+pub mod edges;
+mod light_shape;
+mod presets;
+pub mod technique;
+pub mod wedges;
+
+pub use discrete::CoveredSamples;
+pub use edges::Silhouettes;
+pub use presets::presets;
+pub use technique::{Dcs, PerSampleOutput};

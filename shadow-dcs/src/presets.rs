@@ -1,0 +1,98 @@
+//! DCS presets and their budgets. Every comparison is against the reference evaluating the same
+//! light samples (the suite does this for sample-based techniques), so budgets measure DCS's own
+//! error, not sampling noise:
+//! * exact presets (`dcs-16`, `dcs-64`, `dcs-256`) must agree on at least 99.9% of (pixel,
+//!   sample) pairs and get a tie budget (RMSE 0.002, at most two flipped samples in a pixel);
+//!   on `semi-opaque` their error is the saturating opacity sum against the exact product
+//!   (section 3), measured in [`crate::budgets`] with the margins of [`Budget::from_measured`];
+//! * `dcs-64-interleaved` uses the discrete tables of section 7.3, whose error is measured per
+//!   scene, with at least 99% agreement;
+//! * `dcs-standard-silhouettes` shows the single-light-sample artifact of Fig. 4; its measured
+//!   error is its budget.
+
+use shadow_core::prelude::*;
+
+use crate::budgets;
+use crate::{CoveredSamples, Dcs, Silhouettes};
+
+fn make(samples: u32, strategy: SamplingStrategy, seed: u64) -> Dcs {
+    Dcs::new(samples, strategy, seed).expect("preset sample counts are valid")
+}
+
+/// The budget of an exact preset with `samples` samples: numerical ties only, except on
+/// semi-opaque scenes (`semi` holds the measured approximation error).
+fn exact_budget(samples: u32, semi: &[(&str, [f64; 5])], scene: &str) -> Option<Budget> {
+    let mut b = match Budget::lookup(semi, scene) {
+        Some(b) => b,
+        None if shadow_core::scenes::BUILTIN_SCENES.contains(&scene) => Budget {
+            rmse: 0.002,
+            penumbra_rmse: 0.004,
+            bias: 0.001,
+            max_abs: 2.0 / samples as f64,
+            share_over_0_1: 0.001,
+            false_shadow: 0.001,
+            min_sample_agreement: None,
+        },
+        None => return None,
+    };
+    b.min_sample_agreement = Some(0.999);
+    Some(b)
+}
+
+/// Every DCS preset.
+pub fn presets() -> Vec<Preset> {
+    vec![
+        Preset {
+            name: "dcs-16",
+            description: "DCS, 16 stratified samples, accurate silhouettes, exact covered samples",
+            make: |seed| Box::new(make(16, SamplingStrategy::Stratified, seed).named("dcs-16")),
+            budget: |s| exact_budget(16, budgets::DCS_16_SEMI, s),
+            with_samples: Some(|n, seed| Box::new(make(n, SamplingStrategy::Stratified, seed))),
+        },
+        Preset {
+            name: "dcs-64",
+            description: "DCS, 64 stratified samples, accurate silhouettes, exact covered samples",
+            make: |seed| Box::new(make(64, SamplingStrategy::Stratified, seed).named("dcs-64")),
+            budget: |s| exact_budget(64, budgets::DCS_64_SEMI, s),
+            with_samples: None,
+        },
+        Preset {
+            name: "dcs-64-interleaved",
+            description: "DCS, 64 samples in 4x4 interleaved sets, discrete covered-sample tables (section 7.3)",
+            make: |seed| {
+                Box::new(
+                    make(64, SamplingStrategy::Interleaved { tile: 4 }, seed)
+                        .with_covered_samples(CoveredSamples::Discrete)
+                        .named("dcs-64-interleaved"),
+                )
+            },
+            budget: |s| {
+                Budget::lookup(budgets::DCS_64_INTERLEAVED, s).map(|mut b| {
+                    b.min_sample_agreement = Some(0.99);
+                    b
+                })
+            },
+            with_samples: None,
+        },
+        Preset {
+            name: "dcs-256",
+            description: "DCS, 256 stratified samples, exact covered samples",
+            make: |seed| Box::new(make(256, SamplingStrategy::Stratified, seed).named("dcs-256")),
+            budget: |s| exact_budget(256, budgets::DCS_256_SEMI, s),
+            with_samples: None,
+        },
+        Preset {
+            name: "dcs-standard-silhouettes",
+            description: "DCS, 64 stratified samples, silhouettes from the light centre only (Fig. 4 artifact)",
+            make: |seed| {
+                Box::new(
+                    make(64, SamplingStrategy::Stratified, seed)
+                        .with_silhouettes(Silhouettes::Standard)
+                        .named("dcs-standard-silhouettes"),
+                )
+            },
+            budget: |s| Budget::lookup(budgets::DCS_STANDARD, s),
+            with_samples: None,
+        },
+    ]
+}

@@ -1,0 +1,784 @@
+//! The [`Dcs`] technique: depth complexity sampling (Forest, Barthe and Paulin 2008) on the CPU.
+//!
+//! Per frame (Algorithm 2 for one light):
+//! 1. silhouette edges of the scene for the light (prepared once per scene and light,
+//!    [`crate::edges`], section 4.1);
+//! 2. the integration constant `D(p, c)` of every view sample by the shadow-volume step
+//!    ([`crate::constant`], section 4.1), and the counter width from its maximum (section 5.3);
+//! 3. the wedges' view samples and each one's weight ([`crate::wedges`], section 4.2);
+//! 4. per view sample: its light samples (the shared [`LightSampler`], section 5), the samples
+//!    each wedge edge covers ([`crate::coverage`]; exact or the discrete tables of section 7.3),
+//!    the packed counters updated outer wedges first ([`crate::counters`], sections 4.3-4.4),
+//!    then the visibility coefficient (eq. 1), its RGB form for textured lights (eq. 2), the
+//!    saturating opacity sum for semi-opaque occluders (section 3) and, on request, the direct
+//!    illumination from the per-sample binary visibility (eq. 6).
+//!
+//! Work a view sample does not need is skipped and counted: a receiver facing away from the
+//! whole light is 0 without samples; one in no wedge takes its integration constant for every
+//! sample (fully lit or umbra, no counters); the texture and opacity paths run only when the
+//! light is textured or the scene semi-opaque.
+//!
+//! Light samples behind the receiver's tangent plane are occluded, and view samples are offset
+//! off their surface, exactly as the reference does ([`shadow_core::offset`]), so that with the
+//! same samples the two agree sample by sample up to numerical ties.
+
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+use serde_json::json;
+use shadow_core::direct::pixel_direct;
+use shadow_core::light::{LightKind, LightSample};
+use shadow_core::offset::RayOffset;
+use shadow_core::prelude::*;
+use shadow_core::technique::{Capabilities, Processor, SceneRef};
+use shadow_core::view_samples::ViewSample;
+use shadow_core::visibility::{PerSampleVisibility, PixelClass};
+
+use crate::constant::{eye_constant, integration_constants};
+use crate::counters::{Packed, WIDTHS, width_for};
+use crate::coverage::EdgeTest;
+use crate::discrete::{CoveredSamples, DiscreteTables};
+use crate::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
+use crate::light_shape::LightShape;
+use crate::wedges::{Region, band_pairs, wedge_regions};
+
+/// What per-sample visibility an estimate returns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PerSampleOutput {
+    /// None (saves memory on large images).
+    None,
+    /// One bit per sample, set when the sample is visible (depth complexity 0 and above the
+    /// receiver's horizon): what the conformance suite compares with the reference.
+    Bits,
+    /// The depth complexity of each sample (`u32::MAX` for samples below the horizon), in
+    /// opacity units with semi-opaque occluders.
+    Counters,
+}
+
+struct Prepared {
+    scene: SceneRef,
+    light: Light,
+    shape: LightShape,
+    edges: Vec<SceneEdge>,
+    silhouettes: Vec<u32>,
+    units: u32,
+    offset: RayOffset,
+    tables: Option<DiscreteTables>,
+}
+
+/// Depth complexity sampling.
+pub struct Dcs {
+    name: String,
+    sampler: LightSampler,
+    detection: Silhouettes,
+    covered: CoveredSamples,
+    output: PerSampleOutput,
+    forced_bits: Option<u32>,
+    prepared: Option<Prepared>,
+}
+
+impl std::fmt::Debug for Dcs {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Dcs")
+            .field("name", &self.name)
+            .field("samples", &self.sampler.count())
+            .field("detection", &self.detection)
+            .field("covered", &self.covered)
+            .finish()
+    }
+}
+
+/// Per-frame data shared by every pixel.
+struct Frame<'a> {
+    origins: Vec<Vec3>,
+    horizon: Vec<Horizon>,
+    active: Vec<bool>,
+    constants: Vec<i64>,
+    regions: Vec<Region>,
+    bits: u32,
+    view: &'a ViewSamples,
+}
+
+/// Rows per band: wedge pairs exist for one band at a time, which bounds their memory on scenes
+/// of very high depth complexity (`grass`).
+const BAND_ROWS: u32 = 4;
+
+/// Where the light lies relative to a receiver's tangent plane.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Horizon {
+    Above,
+    Below,
+    Mixed,
+}
+
+/// Per-thread buffers.
+#[derive(Default)]
+struct Scratch {
+    units: Vec<Vec2>,
+    samples: Vec<LightSample>,
+    positions: Vec<Vec3>,
+    above: Vec<u64>,
+    masks: Vec<u64>,
+    weights: Vec<i64>,
+    packed: Packed,
+    plain: Vec<i64>,
+    depth: Vec<u64>,
+    vis: Vec<f32>,
+}
+
+/// Work counters of a row of pixels.
+#[derive(Default, Clone, Copy)]
+struct Counts {
+    facing_away: u64,
+    constant_only: u64,
+    per_sample: u64,
+    edge_tests: u64,
+    covered_updates: u64,
+    escalations: u64,
+    plain_fallback: u64,
+    negative: u64,
+    ties: u64,
+    scanned: u64,
+    pairs: u64,
+}
+
+impl Counts {
+    fn add(&mut self, o: &Counts) {
+        self.facing_away += o.facing_away;
+        self.constant_only += o.constant_only;
+        self.per_sample += o.per_sample;
+        self.edge_tests += o.edge_tests;
+        self.covered_updates += o.covered_updates;
+        self.escalations += o.escalations;
+        self.plain_fallback += o.plain_fallback;
+        self.negative += o.negative;
+        self.ties += o.ties;
+        self.scanned += o.scanned;
+        self.pairs += o.pairs;
+    }
+}
+
+impl Dcs {
+    /// DCS with `samples` light samples per pixel drawn with `strategy` and `seed`, accurate
+    /// silhouettes, exact covered samples and per-sample bits in the output.
+    ///
+    /// # Errors
+    /// The sampler's error for a bad count or tile.
+    pub fn new(
+        samples: u32,
+        strategy: SamplingStrategy,
+        seed: u64,
+    ) -> Result<Self, shadow_core::sampling::SamplingError> {
+        Ok(Self {
+            name: format!("dcs-{samples}"),
+            sampler: LightSampler::new(strategy, samples, seed)?,
+            detection: Silhouettes::Accurate,
+            covered: CoveredSamples::Exact,
+            output: PerSampleOutput::Bits,
+            forced_bits: None,
+            prepared: None,
+        })
+    }
+
+    /// Silhouette detection (section 4.1, Fig. 4).
+    #[must_use]
+    pub fn with_silhouettes(mut self, s: Silhouettes) -> Self {
+        self.detection = s;
+        self
+    }
+
+    /// How covered samples are found (section 7.3).
+    #[must_use]
+    pub fn with_covered_samples(mut self, c: CoveredSamples) -> Self {
+        self.covered = c;
+        self
+    }
+
+    /// What per-sample visibility the estimate carries.
+    #[must_use]
+    pub fn with_per_sample(mut self, o: PerSampleOutput) -> Self {
+        self.output = o;
+        self
+    }
+
+    /// Forces the first counter width tried (8, 16 or 32 bits) instead of the one chosen from
+    /// the largest integration constant; narrower than needed, every overflow is caught and the
+    /// pixel redone wider (tests use this to exercise the escalation).
+    #[must_use]
+    pub fn with_counter_bits(mut self, bits: u32) -> Self {
+        self.forced_bits = Some(bits);
+        self
+    }
+
+    /// Renames the instance (presets).
+    #[must_use]
+    pub fn named(mut self, name: &str) -> Self {
+        self.name = name.into();
+        self
+    }
+
+    fn prepared(&self) -> Result<&Prepared, TechniqueError> {
+        self.prepared
+            .as_ref()
+            .ok_or_else(|| TechniqueError::NotPrepared(self.name.clone()))
+    }
+
+    /// Everything per frame before the per-pixel pass.
+    fn frame<'a>(
+        &self,
+        p: &Prepared,
+        view: &'a ViewSamples,
+        stats: &mut Stats,
+    ) -> Result<Frame<'a>, TechniqueError> {
+        let eye = view.eye().ok_or_else(|| TechniqueError::Unsupported {
+            technique: self.name.clone(),
+            reason: "orthographic views: the shadow-volume step counts quads from an eye point"
+                .into(),
+        })?;
+        let n = view.len();
+        let valid = view.valid_mask();
+        let origins: Vec<Vec3> = (0..n)
+            .map(|i| match view.get(i) {
+                Some(s) => p.offset.offset(s.position, s.geometric_normal),
+                None => Vec3::ZERO,
+            })
+            .collect();
+        let horizon: Vec<Horizon> = (0..n)
+            .map(|i| match view.get(i) {
+                Some(s) => Self::horizon(&p.shape, &s, origins[i]),
+                None => Horizon::Below,
+            })
+            .collect();
+        let active: Vec<bool> = horizon.iter().map(|h| *h != Horizon::Below).collect();
+        let c = p.shape.center;
+        let (constants, quads) = stats.time("shadow-volumes", || {
+            let eye_c = eye_constant(p.scene.as_ref(), p.units, eye, c);
+            integration_constants(
+                &p.edges,
+                &p.silhouettes,
+                c,
+                eye,
+                eye_c,
+                view.raster_view(),
+                &origins,
+                &active,
+            )
+        });
+        stats.add("shadow-volume-quads", quads);
+        let max_constant = constants.iter().copied().max().unwrap_or(0).max(0) as u64;
+        let bits = self.forced_bits.unwrap_or_else(|| width_for(max_constant));
+        stats.add("max-integration-constant", max_constant);
+        stats.add("counter-bits", bits as u64);
+        let (regions, unbounded) = stats.time("wedges", || {
+            wedge_regions(
+                &p.edges,
+                &p.silhouettes,
+                &p.shape,
+                view.raster_view(),
+                &origins,
+                &active,
+            )
+        });
+        stats.add("wedges", regions.len() as u64);
+        stats.add("wedges-unbounded", unbounded);
+        drop(valid);
+        Ok(Frame {
+            origins,
+            horizon,
+            active,
+            constants,
+            regions,
+            bits,
+            view,
+        })
+    }
+
+    /// Runs the per-pixel pass over the rows `rows`: the band's wedge pairs, then every view
+    /// sample, handed to `visit` with its class and the scratch holding its samples and
+    /// visibilities.
+    fn run_band(
+        &self,
+        p: &Prepared,
+        f: &Frame,
+        rows: (u32, u32),
+        counts: &mut Counts,
+        mut visit: impl FnMut(usize, &ViewSample, PixelClass, &Scratch),
+    ) {
+        let view = f.view;
+        let pairs = band_pairs(
+            &p.edges,
+            &f.regions,
+            p.shape.center.as_dvec3(),
+            view.raster_view(),
+            rows,
+            &f.origins,
+            &f.active,
+        );
+        counts.scanned += pairs.scanned;
+        counts.pairs += pairs.entries.len() as u64;
+        let w = view.width() as usize;
+        let mut scratch = Scratch::default();
+        for i in rows.0 as usize * w..(rows.1 as usize + 1) * w {
+            let Some(s) = view.get(i) else { continue };
+            let class = self.pixel(p, f, i, &s, pairs.of(i), &mut scratch, counts);
+            visit(i, &s, class, &scratch);
+        }
+    }
+
+    /// The bands of rows of a view.
+    fn bands(view: &ViewSamples) -> Vec<(u32, u32)> {
+        (0..view.height())
+            .step_by(BAND_ROWS as usize)
+            .map(|y| (y, (y + BAND_ROWS - 1).min(view.height() - 1)))
+            .collect()
+    }
+
+    /// The horizon class of a receiver: the reference's rule, a sample counts when it lies
+    /// above the tangent plane both from the surface point and from the offset origin.
+    fn horizon(shape: &LightShape, s: &ViewSample, origin: Vec3) -> Horizon {
+        let n = s.geometric_normal.as_dvec3();
+        let (lo1, hi1) = shape.range(n, -n.dot(s.position.as_dvec3()));
+        let (lo2, hi2) = shape.range(n, -n.dot(origin.as_dvec3()));
+        if lo1 > 0.0 && lo2 > 0.0 {
+            Horizon::Above
+        } else if !(hi1 > 0.0 && hi2 > 0.0) {
+            Horizon::Below
+        } else {
+            Horizon::Mixed
+        }
+    }
+
+    /// Per-sample visibility of pixel `i` into `scratch.vis` (and depth complexities into
+    /// `scratch.depth`), samples in `scratch.samples`. Returns the class.
+    fn pixel(
+        &self,
+        p: &Prepared,
+        f: &Frame,
+        i: usize,
+        s: &ViewSample,
+        entries: &[(u32, i32)],
+        scratch: &mut Scratch,
+        counts: &mut Counts,
+    ) -> PixelClass {
+        let n = self.sampler.count() as usize;
+        let words = n.div_ceil(64);
+        let origin = f.origins[i];
+        let horizon = f.horizon[i];
+        scratch.vis.clear();
+        scratch.depth.clear();
+        scratch.samples.clear();
+        if horizon == Horizon::Below {
+            counts.facing_away += 1;
+            scratch.vis.resize(n, 0.0);
+            scratch.depth.resize(n, u64::MAX);
+            return PixelClass::Skipped;
+        }
+        let mut d0 = f.constants[i];
+        if d0 < 0 {
+            counts.negative += 1;
+            d0 = 0;
+        }
+        let d0 = d0 as u64;
+        let units = p.units as f32;
+        let textured = p.light.is_textured();
+        if entries.is_empty() && horizon == Horizon::Above {
+            // No wedge: every sample has the integration constant.
+            counts.constant_only += 1;
+            let v = 1.0 - (d0 as f32 / units).min(1.0);
+            scratch.vis.resize(n, v);
+            scratch.depth.resize(n, d0);
+            if textured {
+                self.sampler.unit_samples(s.pixel, &mut scratch.units);
+                let light = p.light.as_ref();
+                scratch
+                    .samples
+                    .extend(scratch.units.iter().map(|u| light.sample(*u)));
+            }
+            return if d0 == 0 {
+                PixelClass::Lit
+            } else if v == 0.0 {
+                PixelClass::Umbra
+            } else {
+                PixelClass::Penumbra
+            };
+        }
+        counts.per_sample += 1;
+        self.sampler.unit_samples(s.pixel, &mut scratch.units);
+        let light = p.light.as_ref();
+        scratch
+            .samples
+            .extend(scratch.units.iter().map(|u| light.sample(*u)));
+        scratch.positions.clear();
+        scratch
+            .positions
+            .extend(scratch.samples.iter().map(|l| l.position));
+        // Samples above the horizon (the reference's rule).
+        scratch.above.clear();
+        scratch.above.resize(words, 0);
+        let nrm = s.geometric_normal;
+        for (k, y) in scratch.positions.iter().enumerate() {
+            if (*y - s.position).dot(nrm) > 0.0 && (*y - origin).dot(nrm) > 0.0 {
+                scratch.above[k / 64] |= 1 << (k % 64);
+            }
+        }
+        // Covered samples of every wedge edge.
+        scratch.masks.clear();
+        scratch.weights.clear();
+        let c = p.shape.center.as_dvec3();
+        let o = origin.as_dvec3();
+        let mut mask = vec![0u64; words];
+        for &(e, k) in entries {
+            let edge = &p.edges[e as usize];
+            let Some(test) = EdgeTest::new(o, c, edge.a, edge.b) else {
+                counts.ties += 1;
+                continue;
+            };
+            counts.edge_tests += 1;
+            let any = match (&self.covered, &p.tables) {
+                (CoveredSamples::Discrete, Some(t)) => t.mask(
+                    s.pixel,
+                    &test,
+                    o,
+                    c,
+                    edge,
+                    &scratch.positions,
+                    &scratch.above,
+                    &mut mask,
+                ),
+                _ => test.mask(&scratch.positions, &scratch.above, &mut mask),
+            };
+            if any {
+                counts.covered_updates += 1;
+                scratch.masks.extend_from_slice(&mask);
+                scratch.weights.push(k as i64);
+            }
+        }
+        // Packed counters, outer wedges (k > 0) before inner ones (section 4.4); wider lanes on
+        // overflow, plain signed counters as the last resort.
+        let mut done = false;
+        for bits in WIDTHS.into_iter().filter(|&b| b >= f.bits) {
+            if run_packed(
+                &mut scratch.packed,
+                bits,
+                n,
+                d0,
+                &scratch.masks,
+                &scratch.weights,
+            )
+            .is_ok()
+            {
+                scratch.depth.extend((0..n).map(|k| scratch.packed.get(k)));
+                done = true;
+                break;
+            }
+            counts.escalations += 1;
+        }
+        if !done {
+            counts.plain_fallback += 1;
+            scratch.plain.clear();
+            scratch.plain.resize(n, d0 as i64);
+            for (m, &k) in scratch.masks.chunks(words).zip(&scratch.weights) {
+                for j in 0..n {
+                    if m[j / 64] >> (j % 64) & 1 == 1 {
+                        scratch.plain[j] = scratch.plain[j].saturating_add(k);
+                    }
+                }
+            }
+            if scratch.plain.iter().any(|&d| d < 0) {
+                counts.negative += 1;
+            }
+            scratch
+                .depth
+                .extend(scratch.plain.iter().map(|&d| d.max(0) as u64));
+        }
+        let (mut lit, mut dark) = (true, true);
+        for k in 0..n {
+            let v = if scratch.above[k / 64] >> (k % 64) & 1 == 1 {
+                1.0 - (scratch.depth[k] as f32 / units).min(1.0)
+            } else {
+                scratch.depth[k] = u64::MAX;
+                0.0
+            };
+            lit &= v == 1.0;
+            dark &= v == 0.0;
+            scratch.vis.push(v);
+        }
+        if lit {
+            PixelClass::Lit
+        } else if dark {
+            PixelClass::Umbra
+        } else {
+            PixelClass::Penumbra
+        }
+    }
+
+    /// Direct illumination of every view sample by DCS eq. 6: the light samples' contributions
+    /// weighted by their binary visibility (saturated opacity sums with semi-opaque occluders).
+    ///
+    /// # Errors
+    /// [`TechniqueError::NotPrepared`] before `prepare`; `Unsupported` for orthographic views.
+    pub fn direct_illumination(&self, view: &ViewSamples) -> Result<Vec<Vec3>, TechniqueError> {
+        let p = self.prepared()?;
+        let mut stats = Stats::default();
+        let f = self.frame(p, view, &mut stats)?;
+        let w = view.width() as usize;
+        let bands = Self::bands(view);
+        let parts: Vec<Vec<Vec3>> = bands
+            .par_iter()
+            .map(|&rows| {
+                let first = rows.0 as usize * w;
+                let mut out = vec![Vec3::ZERO; (rows.1 - rows.0 + 1) as usize * w];
+                let mut counts = Counts::default();
+                let mut units = Vec::new();
+                let mut samples = Vec::new();
+                self.run_band(p, &f, rows, &mut counts, |i, s, _, scratch| {
+                    let light = p.light.as_ref();
+                    let samples: &[LightSample] = if scratch.samples.is_empty() {
+                        self.sampler.unit_samples(s.pixel, &mut units);
+                        samples.clear();
+                        samples.extend(units.iter().map(|u| light.sample(*u)));
+                        &samples
+                    } else {
+                        &scratch.samples
+                    };
+                    let albedo = p.scene.albedo(s.triangle as usize);
+                    let vis = &scratch.vis;
+                    out[i - first] = pixel_direct(s, albedo, light, samples, |k| vis[k]);
+                });
+                out
+            })
+            .collect();
+        let out: Vec<Vec3> = parts.into_iter().flatten().collect();
+        Ok(out)
+    }
+}
+
+/// Applies the updates with packed counters of `bits` bits.
+fn run_packed(
+    packed: &mut Packed,
+    bits: u32,
+    n: usize,
+    d0: u64,
+    masks: &[u64],
+    weights: &[i64],
+) -> Result<(), crate::counters::OutOfRange> {
+    packed.reset(bits, n, d0)?;
+    let words = n.div_ceil(64);
+    for outer in [true, false] {
+        for (m, &k) in masks.chunks(words).zip(weights) {
+            if (k > 0) != outer {
+                continue;
+            }
+            if k > 0 {
+                packed.add(m, k as u64)?;
+            } else {
+                packed.sub(m, k.unsigned_abs())?;
+            }
+        }
+    }
+    Ok(())
+}
+
+impl ShadowTechnique for Dcs {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn capabilities(&self) -> Capabilities {
+        Capabilities {
+            lights: vec![
+                LightKind::Rectangle,
+                LightKind::Disk,
+                LightKind::Polygon,
+                LightKind::Sphere,
+            ],
+            semi_opaque: true,
+            textured_lights: true,
+            needs_closed_meshes: false,
+            sample_based: true,
+            processor: Processor::Cpu,
+        }
+    }
+
+    fn parameters(&self) -> serde_json::Value {
+        json!({
+            "samples": self.sampler.count(),
+            "strategy": format!("{:?}", self.sampler.strategy()),
+            "seed": self.sampler.seed(),
+            "silhouettes": format!("{:?}", self.detection),
+            "covered_samples": format!("{:?}", self.covered),
+        })
+    }
+
+    fn light_sampler(&self) -> Option<&LightSampler> {
+        Some(&self.sampler)
+    }
+
+    fn prepare(&mut self, scene: SceneRef, light: Light) -> Result<Stats, TechniqueError> {
+        self.prepared = None;
+        let caps = self.capabilities();
+        caps.check(scene.as_ref(), light.as_ref())
+            .map_err(|reason| TechniqueError::Unsupported {
+                technique: self.name.clone(),
+                reason,
+            })?;
+        let mut stats = Stats::default();
+        let shape = LightShape::new(light.as_ref(), &self.name)?;
+        let (edges, units) = stats.time("edges", || scene_edges(scene.as_ref(), shape.center));
+        let sil = stats.time("silhouettes", || {
+            silhouettes(&edges, &shape, self.detection)
+        });
+        stats.add("edges", edges.len() as u64);
+        stats.add("silhouette-edges", sil.len() as u64);
+        let tables = match self.covered {
+            CoveredSamples::Discrete => Some(stats.time("discrete-tables", || {
+                DiscreteTables::build(&self.sampler, light.as_ref(), &shape, &self.name)
+            })?),
+            CoveredSamples::Exact => None,
+        };
+        let extent = scene.bounds().union(light.bounds()).diagonal();
+        self.prepared = Some(Prepared {
+            scene,
+            light,
+            shape,
+            edges,
+            silhouettes: sil,
+            units,
+            offset: RayOffset::for_extent(extent),
+            tables,
+        });
+        Ok(stats)
+    }
+
+    fn estimate(&mut self, view: &ViewSamples) -> Result<Estimate, TechniqueError> {
+        let p = self.prepared()?;
+        let mut stats = Stats::default();
+        let f = self.frame(p, view, &mut stats)?;
+        let n = self.sampler.count() as usize;
+        let words = n.div_ceil(64);
+        let w = view.width() as usize;
+        let textured = p.light.is_textured();
+        struct Row {
+            v: Vec<f32>,
+            rgb: Vec<Vec3>,
+            class: Vec<PixelClass>,
+            bits: Vec<u64>,
+            depth: Vec<u32>,
+            counts: Counts,
+        }
+        let output = self.output;
+        let bands = Self::bands(view);
+        let rows: Vec<Row> = stats.time("depth-complexity", || {
+            bands
+                .par_iter()
+                .map(|&rows| {
+                    let m = (rows.1 - rows.0 + 1) as usize * w;
+                    let first = rows.0 as usize * w;
+                    let mut r = Row {
+                        v: vec![0.0; m],
+                        rgb: vec![Vec3::ZERO; if textured { m } else { 0 }],
+                        class: vec![PixelClass::Background; m],
+                        bits: vec![
+                            0;
+                            if output == PerSampleOutput::Bits {
+                                m * words
+                            } else {
+                                0
+                            }
+                        ],
+                        depth: vec![
+                            0;
+                            if output == PerSampleOutput::Counters {
+                                m * n
+                            } else {
+                                0
+                            }
+                        ],
+                        counts: Counts::default(),
+                    };
+                    let mut counts = Counts::default();
+                    self.run_band(p, &f, rows, &mut counts, |i, _, class, scratch| {
+                        let x = i - first;
+                        r.class[x] = class;
+                        let vis = &scratch.vis;
+                        let sum: f64 = vis.iter().map(|&v| v as f64).sum();
+                        r.v[x] = (sum / n as f64) as f32;
+                        if textured {
+                            let acc = scratch
+                                .samples
+                                .iter()
+                                .zip(vis)
+                                .fold(Vec3::ZERO, |a, (l, v)| a + l.radiance * *v);
+                            r.rgb[x] = acc / n as f32;
+                        }
+                        match output {
+                            PerSampleOutput::Bits => {
+                                for (k, &v) in vis.iter().enumerate() {
+                                    if v == 1.0 {
+                                        r.bits[x * words + k / 64] |= 1 << (k % 64);
+                                    }
+                                }
+                            }
+                            PerSampleOutput::Counters => {
+                                for (k, &d) in scratch.depth.iter().enumerate() {
+                                    r.depth[x * n + k] = d.min(u32::MAX as u64) as u32;
+                                }
+                            }
+                            PerSampleOutput::None => {}
+                        }
+                    });
+                    r.counts = counts;
+                    r
+                })
+                .collect()
+        });
+        let mut vis = if textured {
+            VisibilityImage::rgb_buffer(view)
+        } else {
+            VisibilityImage::scalar(view)
+        };
+        let mut classes = Vec::with_capacity(view.len());
+        let mut counts = Counts::default();
+        let mut bits = Vec::new();
+        let mut depth = Vec::new();
+        for (&band, r) in bands.iter().zip(rows) {
+            let range = band.0 as usize * w..(band.1 as usize + 1) * w;
+            if textured {
+                vis.rgbs_mut()[range].copy_from_slice(&r.rgb);
+            } else {
+                vis.scalars_mut()[range].copy_from_slice(&r.v);
+            }
+            classes.extend(r.class);
+            bits.extend(r.bits);
+            depth.extend(r.depth);
+            counts.add(&r.counts);
+        }
+        vis.set_classes(classes)?;
+        match output {
+            PerSampleOutput::Bits => vis.set_per_sample(PerSampleVisibility::Bits {
+                samples: n as u32,
+                words: bits,
+            })?,
+            PerSampleOutput::Counters => vis.set_per_sample(PerSampleVisibility::Counters {
+                samples: n as u32,
+                counts: depth,
+            })?,
+            PerSampleOutput::None => {}
+        }
+        stats.add("pixels-facing-away", counts.facing_away);
+        stats.add("pixels-constant-only", counts.constant_only);
+        stats.add("pixels-per-sample", counts.per_sample);
+        stats.add("edge-tests", counts.edge_tests);
+        stats.add("covered-updates", counts.covered_updates);
+        stats.add("counter-escalations", counts.escalations);
+        stats.add("plain-counter-fallbacks", counts.plain_fallback);
+        stats.add("negative-depth-complexity", counts.negative);
+        stats.add("edge-ties", counts.ties);
+        stats.add("wedge-pixels-scanned", counts.scanned);
+        stats.add("wedge-pairs", counts.pairs);
+        vis.validate()?;
+        Ok(Estimate {
+            visibility: vis,
+            stats,
+        })
+    }
+}
