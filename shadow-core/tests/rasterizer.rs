@@ -286,3 +286,50 @@ fn output_does_not_depend_on_thread_count() {
     let b = ViewSamples::render(&scene, &cam, 61, 47).unwrap();
     assert_eq!(a, b);
 }
+
+#[test]
+fn covered_pixels_equal_the_rasterizer_coverage() {
+    // Big, thin, clipped and tiny triangles: the span walk must visit exactly the pixels the
+    // rasterizer covers.
+    let cam = Camera::look_at(Vec3::new(0.3, 1.0, 4.0), Vec3::ZERO, Vec3::Y, 0.9).unwrap();
+    let view = cam.raster_view(97, 61);
+    let tris = [
+        [
+            Vec3::new(-3.0, -2.0, 0.0),
+            Vec3::new(3.0, -1.5, -1.0),
+            Vec3::new(0.1, 2.5, 0.5),
+        ],
+        [
+            Vec3::new(-0.5, 0.0, 0.0),
+            Vec3::new(0.5, 0.01, 0.0),
+            Vec3::new(0.4, 0.03, 0.2),
+        ],
+        [
+            Vec3::new(-1.0, 0.0, 6.0),
+            Vec3::new(1.0, 0.0, -3.0),
+            Vec3::new(0.0, 1.0, -3.0),
+        ],
+        [
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(0.001, 0.0, 0.0),
+            Vec3::new(0.0, 0.001, 0.0),
+        ],
+        [
+            Vec3::new(-40.0, -30.0, -50.0),
+            Vec3::new(40.0, -30.0, -50.0),
+            Vec3::new(0.0, 60.0, -50.0),
+        ],
+    ];
+    for tri in tris {
+        let frags = rasterize(&tri, &[[0, 1, 2]], &view, 1).unwrap();
+        let mut visited = vec![false; (view.width * view.height) as usize];
+        shadow_core::raster::for_each_covered_pixel(&view, tri, |x, y| {
+            let i = (y * view.width + x) as usize;
+            assert!(!visited[i], "pixel visited twice");
+            visited[i] = true;
+        });
+        for (i, v) in visited.iter().enumerate() {
+            assert_eq!(*v, frags.triangle[i] != NO_TRIANGLE, "{tri:?} pixel {i}");
+        }
+    }
+}

@@ -87,30 +87,31 @@ impl Packed {
 
     /// Adds `k` to every counter whose bit is set in `mask`.
     pub fn add(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
-        if k > Self::lane_max(self.bits) {
-            return Err(OutOfRange);
-        }
-        let high = ones(self.bits) << (self.bits - 1);
-        let low = !high;
-        for w in 0..self.words.len() {
-            let m = self.lane_bits(mask, w);
-            if m == 0 {
-                continue;
-            }
-            let x = self.words[w];
-            let y = spread(m, self.bits) * k;
+        self.update(mask, k, |x, y, high, low| {
             let s = ((x & low) + (y & low)) ^ ((x ^ y) & high);
-            let carry = ((x & y) | ((x | y) & !s)) & high;
-            if carry != 0 {
-                return Err(OutOfRange);
-            }
-            self.words[w] = s;
-        }
-        Ok(())
+            // Carry out of each lane's top bit.
+            (s, ((x & y) | ((x | y) & !s)) & high)
+        })
     }
 
     /// Subtracts `k` from every counter whose bit is set in `mask`.
     pub fn sub(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
+        self.update(mask, k, |x, y, high, low| {
+            let d = ((x | high) - (y & low)) ^ ((x ^ !y) & high);
+            // Borrow out of each lane's top bit.
+            (d, ((!x & y) | (!(x ^ y) & d)) & high)
+        })
+    }
+
+    /// Applies a lane-wise operation `op(x, y, high, low) -> (result, out-of-range lanes)` with
+    /// `y` holding `k` in the lanes `mask` selects; stops at the first word that leaves range.
+    #[inline]
+    fn update(
+        &mut self,
+        mask: &[u64],
+        k: u64,
+        op: impl Fn(u64, u64, u64, u64) -> (u64, u64),
+    ) -> Result<(), OutOfRange> {
         if k > Self::lane_max(self.bits) {
             return Err(OutOfRange);
         }
@@ -121,14 +122,11 @@ impl Packed {
             if m == 0 {
                 continue;
             }
-            let x = self.words[w];
-            let y = spread(m, self.bits) * k;
-            let d = ((x | high) - (y & low)) ^ ((x ^ !y) & high);
-            let borrow = ((!x & y) | (!(x ^ y) & d)) & high;
-            if borrow != 0 {
+            let (r, out) = op(self.words[w], spread(m, self.bits) * k, high, low);
+            if out != 0 {
                 return Err(OutOfRange);
             }
-            self.words[w] = d;
+            self.words[w] = r;
         }
         Ok(())
     }

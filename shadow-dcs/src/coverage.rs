@@ -12,22 +12,45 @@
 
 use glam::{DVec3, Vec3};
 
+/// A pixel's light samples relative to its view sample `p`, structure of arrays, padded to
+/// whole 64-sample words so the per-edge loop has no tail and vectorises.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct RelativeSamples {
+    x: Vec<f32>,
+    y: Vec<f32>,
+    z: Vec<f32>,
+}
+
+impl RelativeSamples {
+    /// Sets the samples `positions - p`.
+    pub fn set(&mut self, p: Vec3, positions: &[Vec3]) {
+        let padded = positions.len().div_ceil(64) * 64;
+        for v in [&mut self.x, &mut self.y, &mut self.z] {
+            v.clear();
+            v.resize(padded, 0.0);
+        }
+        for (k, s) in positions.iter().enumerate() {
+            let d = *s - p;
+            self.x[k] = d.x;
+            self.y[k] = d.y;
+            self.z[k] = d.z;
+        }
+    }
+}
+
 /// The four linear tests of one (view sample, edge) pair.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct EdgeTest {
-    p: Vec3,
-    a: Vec3,
     /// `orient(p, c, s, a) = ga . (s - p)`.
     ga: Vec3,
     /// `orient(p, c, s, b) = gb . (s - p)`.
     gb: Vec3,
-    /// `orient(a, b, c, s) = h1 . (s - a)`.
+    /// `+-orient(a, b, c, s) = h1 . (s - p) + k1`, the sign chosen so that the line `a b`
+    /// passes inside the triangle when this and the next are positive.
     h1: Vec3,
-    /// `orient(a, b, s, p) = h2 . (s - a)`.
+    k1: f32,
+    /// `+-orient(a, b, s, p) = h2 . (s - p)` (no constant: it vanishes at `s = p`).
     h2: Vec3,
-    /// Sign of `orient(a, b, p, c)`: the line `a b` passes inside the triangle when all three
-    /// edge tests share it.
-    positive: bool,
 }
 
 impl EdgeTest {
@@ -42,50 +65,57 @@ impl EdgeTest {
         if k0 == 0.0 || !k0.is_finite() {
             return None;
         }
+        // orient(a, b, c, s) = h1 . (s - a) = h1 . (s - p) + h1 . (p - a).
+        let k1 = h1.dot(p - a);
+        let sign = if k0 > 0.0 { 1.0 } else { -1.0 };
         Some(Self {
-            p: p.as_vec3(),
-            a: a.as_vec3(),
             ga: ga.as_vec3(),
             gb: gb.as_vec3(),
-            h1: h1.as_vec3(),
-            h2: h2.as_vec3(),
-            positive: k0 > 0.0,
+            h1: (h1 * sign).as_vec3(),
+            k1: (k1 * sign) as f32,
+            h2: (h2 * sign).as_vec3(),
         })
     }
 
-    /// True when the edge crosses the triangle `(p, c, s)`.
-    #[inline]
-    pub fn covers(&self, s: Vec3) -> bool {
-        let sp = s - self.p;
-        let sa = s - self.a;
-        let (va, vb) = (self.ga.dot(sp), self.gb.dot(sp));
-        if !((va > 0.0 && vb < 0.0) || (va < 0.0 && vb > 0.0)) {
-            return false;
-        }
-        let (w1, w2) = (self.h1.dot(sa), self.h2.dot(sa));
-        if self.positive {
-            w1 > 0.0 && w2 > 0.0
-        } else {
-            w1 < 0.0 && w2 < 0.0
-        }
+    /// True when the edge crosses the triangle `(p, c, p + d)`, `d` a sample relative to `p`.
+    #[inline(always)]
+    fn covers_relative(&self, x: f32, y: f32, z: f32) -> bool {
+        let va = self.ga.x * x + self.ga.y * y + self.ga.z * z;
+        let vb = self.gb.x * x + self.gb.y * y + self.gb.z * z;
+        let w1 = self.h1.x * x + self.h1.y * y + self.h1.z * z + self.k1;
+        let w2 = self.h2.x * x + self.h2.y * y + self.h2.z * z;
+        let sector = (va > 0.0) & (vb < 0.0) | (va < 0.0) & (vb > 0.0);
+        sector & (w1 > 0.0) & (w2 > 0.0)
     }
 
-    /// Sets in `mask` (cleared first) the bits of the samples in `samples` the edge covers,
-    /// restricted to `allowed`.
-    pub fn mask(&self, samples: &[Vec3], allowed: &[u64], mask: &mut [u64]) -> bool {
+    /// True when the edge crosses the triangle `(p, c, s)`.
+    #[cfg(test)]
+    pub fn covers(&self, p: Vec3, s: Vec3) -> bool {
+        let d = s - p;
+        self.covers_relative(d.x, d.y, d.z)
+    }
+
+    /// Sets in `mask` the bits of the samples the edge covers, restricted to `allowed`;
+    /// returns whether any is set.
+    pub fn mask(&self, samples: &RelativeSamples, allowed: &[u64], mask: &mut [u64]) -> bool {
         let mut any = 0u64;
         for (w, word) in mask.iter_mut().enumerate() {
-            let mut bits = 0u64;
-            let mut todo = allowed[w];
-            while todo != 0 {
-                let k = todo.trailing_zeros();
-                todo &= todo - 1;
-                if self.covers(samples[w * 64 + k as usize]) {
-                    bits |= 1 << k;
-                }
+            let base = w * 64;
+            let (xs, ys, zs) = (
+                &samples.x[base..base + 64],
+                &samples.y[base..base + 64],
+                &samples.z[base..base + 64],
+            );
+            let mut hits = [false; 64];
+            for j in 0..64 {
+                hits[j] = self.covers_relative(xs[j], ys[j], zs[j]);
             }
-            *word = bits;
-            any |= bits;
+            let mut bits = 0u64;
+            for (j, h) in hits.iter().enumerate() {
+                bits |= (*h as u64) << j;
+            }
+            *word = bits & allowed[w];
+            any |= *word;
         }
         any != 0
     }
@@ -130,7 +160,7 @@ mod tests {
                     -0.5 + (j as f64 + 0.5) / n as f64,
                 );
                 let want = brute(p, c, s, a, b);
-                let got = t.covers(s.as_vec3());
+                let got = t.covers(p.as_vec3(), s.as_vec3());
                 covered += want as u32;
                 agree += (want == got) as u32;
             }

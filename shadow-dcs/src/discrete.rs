@@ -18,12 +18,12 @@
 
 use std::f64::consts::TAU;
 
-use glam::{DVec2, DVec3, UVec2, Vec3};
+use glam::{DVec2, DVec3, UVec2};
 use shadow_core::light::{AreaLight, LightGeometry};
 use shadow_core::sampling::{LightSampler, SamplingStrategy};
 use shadow_core::technique::TechniqueError;
 
-use crate::coverage::EdgeTest;
+use crate::coverage::{EdgeTest, RelativeSamples};
 use crate::edges::SceneEdge;
 use crate::light_shape::LightShape;
 
@@ -174,7 +174,7 @@ impl DiscreteTables {
         p: DVec3,
         _c: DVec3,
         edge: &SceneEdge,
-        samples: &[Vec3],
+        relative: &RelativeSamples,
         allowed: &[u64],
         mask: &mut [u64],
     ) -> bool {
@@ -184,14 +184,14 @@ impl DiscreteTables {
         // Both end points strictly between p's parallel plane and the light plane.
         let inside = |x: f64| (h > 0.0 && x > 0.0 && x < h) || (h < 0.0 && x < 0.0 && x > h);
         if !(inside(ha) && inside(hb)) {
-            return test.mask(samples, allowed, mask);
+            return test.mask(relative, allowed, mask);
         }
         let (a2, b2) = (self.project(p, edge.a), self.project(p, edge.b));
         let d = b2 - a2;
         let cross = a2.perp_dot(b2);
         let len = d.length();
         if !(len > 0.0) || (cross / len).abs() < 1e-9 * self.half {
-            return test.mask(samples, allowed, mask);
+            return test.mask(relative, allowed, mask);
         }
         // Foot of the perpendicular from the centre (origin) to the line.
         let foot = a2 - d * (a2.dot(d) / (len * len));

@@ -35,7 +35,7 @@ use shadow_core::visibility::{PerSampleVisibility, PixelClass};
 
 use crate::constant::{eye_constant, integration_constants};
 use crate::counters::{Packed, WIDTHS, width_for};
-use crate::coverage::EdgeTest;
+use crate::coverage::{EdgeTest, RelativeSamples};
 use crate::discrete::{CoveredSamples, DiscreteTables};
 use crate::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
 use crate::light_shape::LightShape;
@@ -62,6 +62,7 @@ struct Prepared {
     silhouettes: Vec<u32>,
     units: u32,
     offset: RayOffset,
+    extent: f64,
     tables: Option<DiscreteTables>,
 }
 
@@ -116,6 +117,7 @@ struct Scratch {
     units: Vec<Vec2>,
     samples: Vec<LightSample>,
     positions: Vec<Vec3>,
+    relative: RelativeSamples,
     above: Vec<u64>,
     masks: Vec<u64>,
     weights: Vec<i64>,
@@ -312,6 +314,7 @@ impl Dcs {
             rows,
             &f.origins,
             &f.active,
+            p.extent,
         );
         counts.scanned += pairs.scanned;
         counts.pairs += pairs.entries.len() as u64;
@@ -425,6 +428,7 @@ impl Dcs {
         scratch.weights.clear();
         let c = p.shape.center.as_dvec3();
         let o = origin.as_dvec3();
+        scratch.relative.set(origin, &scratch.positions);
         let mut mask = vec![0u64; words];
         for &(e, k) in entries {
             let edge = &p.edges[e as usize];
@@ -440,11 +444,11 @@ impl Dcs {
                     o,
                     c,
                     edge,
-                    &scratch.positions,
+                    &scratch.relative,
                     &scratch.above,
                     &mut mask,
                 ),
-                _ => test.mask(&scratch.positions, &scratch.above, &mut mask),
+                _ => test.mask(&scratch.relative, &scratch.above, &mut mask),
             };
             if any {
                 counts.covered_updates += 1;
@@ -644,6 +648,7 @@ impl ShadowTechnique for Dcs {
             silhouettes: sil,
             units,
             offset: RayOffset::for_extent(extent),
+            extent: extent as f64,
             tables,
         });
         Ok(stats)

@@ -47,6 +47,176 @@ pub(crate) struct Region {
     /// Convex polygon in pixel units; `None` scans the whole image.
     poly: Option<Vec<DVec2>>,
     rows: (u32, u32),
+    /// Half-spaces holding the wedge ([`wedge_planes`]).
+    planes: Vec<Plane>,
+    /// The planes of the edge's two faces, oriented by the edge, when the edge's weight can
+    /// only be non-zero where it is a silhouette of the view sample ([`fold_planes`]).
+    fold: Option<(Plane, Plane)>,
+}
+
+/// A half-space `n . x + d >= 0` (`n` unit).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Plane {
+    n: DVec3,
+    d: f64,
+}
+
+impl Plane {
+    #[inline]
+    fn eval(&self, x: DVec3) -> f64 {
+        self.n.dot(x) + self.d
+    }
+    /// The largest value over a box (its corner furthest along `n`).
+    #[inline]
+    fn max_over(&self, lo: DVec3, hi: DVec3) -> f64 {
+        let x = DVec3::new(
+            if self.n.x > 0.0 { hi.x } else { lo.x },
+            if self.n.y > 0.0 { hi.y } else { lo.y },
+            if self.n.z > 0.0 { hi.z } else { lo.z },
+        );
+        self.eval(x)
+    }
+}
+
+/// Half-spaces that hold the wedge of edge `e` (AAM03's wedge planes, made conservative for a
+/// segment and a convex light with hull points `hull` around centre `c`):
+/// * the two planes through the edge's line that support the light: every point
+///   `x + t (x - y)` lies on the side away from the light (`n . (x - a) = 0` on the line, and
+///   `n . (y - a) <= 0` for every light point);
+/// * a side plane at each end point `v` with normal `n`, `n . (w - v) >= 0` toward the other end
+///   `w` and `n . (y - v) <= 0` for every light point, which holds the whole wedge by the same
+///   argument (kept only when such an `n` is found by tilting the edge direction away from the
+///   light).
+///
+/// A view sample outside any of them cannot see the edge over the light, so the exact weight
+/// need not be computed.
+pub(crate) fn wedge_planes(e: &SceneEdge, hull: &[DVec3], c: DVec3) -> Vec<Plane> {
+    let mut planes = Vec::with_capacity(4);
+    let ab = e.b - e.a;
+    let scale = ab.length() + hull.iter().map(|l| (*l - e.a).length()).fold(0.0, f64::max);
+    let eps = 1e-9 * scale;
+    let plane = |n: DVec3, at: DVec3| -> Option<Plane> {
+        let len = n.length();
+        (len > 0.0 && len.is_finite()).then(|| {
+            let n = n / len;
+            Plane {
+                n,
+                d: -n.dot(at) + 1e-6 * scale,
+            }
+        })
+    };
+    for l in hull {
+        let n = ab.cross(*l - e.a);
+        let len = n.length();
+        if !(len > eps * scale) {
+            continue;
+        }
+        let sides = hull.iter().map(|q| n.dot(*q - e.a) / len);
+        let (lo, hi) = sides.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+        if hi <= eps {
+            planes.extend(plane(n, e.a));
+        } else if lo >= -eps {
+            planes.extend(plane(-n, e.a));
+        }
+    }
+    // Both tangent planes are found once per supporting vertex; keep distinct ones.
+    planes.dedup_by(|x, y| (x.n - y.n).length_squared() < 1e-18);
+    for (v, w) in [(e.a, e.b), (e.b, e.a)] {
+        let d = w - v;
+        let u = c - v;
+        let uu = u.length_squared();
+        if !(uu > 0.0) {
+            continue;
+        }
+        let perp = d - u * (d.dot(u) / uu);
+        let mut lambda = 0.0f64;
+        let mut ok = true;
+        for l in hull {
+            let den = u.dot(*l - v);
+            if !(den > 0.0) {
+                ok = false;
+                break;
+            }
+            lambda = lambda.max(perp.dot(*l - v) / den);
+        }
+        let n = perp - u * lambda;
+        if ok && n.dot(d) >= 0.0 {
+            planes.extend(plane(n, v));
+        }
+    }
+    planes
+}
+
+/// For a manifold edge whose faces weigh the same, `k_e(p)` is non-zero only where both faces
+/// lie on one side of the plane through `p` and the edge (the edge is a silhouette of `p`):
+/// with `P_i(p) = orient(w_i, a, b, p)` that is `P_1(p) P_2(p) > 0`. Two plane evaluations then
+/// replace the full weight where the edge is not a silhouette of the pixel. Both planes carry
+/// a small slack so that the prefilter never rejects a tie the exact weight would keep.
+pub(crate) fn fold_planes(e: &SceneEdge) -> Option<(Plane, Plane)> {
+    if e.always || e.faces.len() != 2 {
+        return None;
+    }
+    let plane = |w: DVec3| -> Option<Plane> {
+        let n = (e.a - w).cross(e.b - w);
+        let len = n.length();
+        (len > 0.0 && len.is_finite()).then(|| {
+            let n = n / len;
+            Plane { n, d: -n.dot(w) }
+        })
+    };
+    let (p1, p2) = (plane(e.faces[0].third)?, plane(e.faces[1].third)?);
+    Some((p1, p2))
+}
+
+/// Slack of the fold prefilter (distance), relative to the scene's extent.
+const FOLD_SLACK: f64 = 1e-6;
+
+/// Whether a box may hold a view sample of which the edge is a silhouette.
+#[inline]
+fn fold_possible_in(f: &(Plane, Plane), lo: DVec3, hi: DVec3, slack: f64) -> bool {
+    let (max1, max2) = (f.0.max_over(lo, hi), f.1.max_over(lo, hi));
+    let (min1, min2) = (-neg(f.0).max_over(lo, hi), -neg(f.1).max_over(lo, hi));
+    (max1 > -slack && max2 > -slack) || (min1 < slack && min2 < slack)
+}
+
+#[inline]
+fn neg(p: Plane) -> Plane {
+    Plane { n: -p.n, d: -p.d }
+}
+
+/// Per-tile bounds of the active view samples: tiles of [`TILE_W`] columns by one band of rows.
+pub(crate) const TILE_W: u32 = 4;
+
+/// `None` for a tile with no active view sample.
+pub(crate) type TileBox = Option<(DVec3, DVec3)>;
+
+/// The bounds of every tile of a band.
+fn band_tiles(
+    view: &RasterView,
+    rows: (u32, u32),
+    origins: &[Vec3],
+    active: &[bool],
+) -> Vec<TileBox> {
+    let w = view.width as usize;
+    let tiles = view.width.div_ceil(TILE_W) as usize;
+    let mut out: Vec<TileBox> = vec![None; tiles];
+    for y in rows.0..=rows.1 {
+        for x in 0..w {
+            let i = y as usize * w + x;
+            if !active[i] {
+                continue;
+            }
+            let p = origins[i].as_dvec3();
+            let t = &mut out[x / TILE_W as usize];
+            *t = Some(match *t {
+                Some((lo, hi)) => (lo.min(p), hi.max(p)),
+                None => (p, p),
+            });
+        }
+    }
+    out
 }
 
 /// The screen regions of every silhouette edge's wedge, in edge order (empty regions dropped).
@@ -75,11 +245,18 @@ pub(crate) fn wedge_regions(
         .par_iter()
         .filter_map(|&ei| {
             let e = &edges[ei as usize];
+            let planes = wedge_planes(e, &hull, c);
+            let fold = fold_planes(e);
+            if planes.iter().any(|p| p.max_over(lo, hi) < 0.0) {
+                return None;
+            }
             match screen_region(e, &hull, c, light.radius as f64, lo, hi, view) {
                 None => Some(Region {
                     edge: ei,
                     poly: None,
                     rows: (0, view.height - 1),
+                    planes,
+                    fold,
                 }),
                 Some(poly) => {
                     let rows = polygon_rows(&poly, view.height)?;
@@ -87,6 +264,8 @@ pub(crate) fn wedge_regions(
                         edge: ei,
                         poly: Some(poly),
                         rows,
+                        planes,
+                        fold,
                     })
                 }
             }
@@ -106,36 +285,72 @@ pub(crate) fn band_pairs(
     rows: (u32, u32),
     origins: &[Vec3],
     active: &[bool],
+    scale: f64,
 ) -> WedgePairs {
     let w = view.width as usize;
     let first = rows.0 as usize * w;
     let n = (rows.1 - rows.0 + 1) as usize * w;
     let mut found: Vec<(u32, u32, i32)> = Vec::new();
     let mut scanned = 0u64;
+    let tiles = band_tiles(view, rows, origins, active);
+    let slack = FOLD_SLACK * scale;
+    let mut spans: Vec<(u32, u32, u32)> = Vec::with_capacity(4);
     for r in regions {
         if r.rows.1 < rows.0 || r.rows.0 > rows.1 {
             continue;
         }
         let e = &edges[r.edge as usize];
-        let mut visit = |x: u32, y: u32| {
-            let i = y as usize * w + x as usize;
-            scanned += 1;
-            if !active[i] {
-                return;
+        spans.clear();
+        for y in rows.0.max(r.rows.0)..=rows.1.min(r.rows.1) {
+            let span = match &r.poly {
+                Some(poly) => row_span(poly, y, view.width),
+                None => Some((0, view.width - 1)),
+            };
+            if let Some((x0, x1)) = span {
+                spans.push((y, x0, x1));
             }
-            if let Some(k) = e.sweep_weight(origins[i].as_dvec3(), c, false)
-                && k != 0
-            {
-                let k = k.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
-                found.push(((i - first) as u32, r.edge, k));
-            }
+        }
+        let (Some(xmin), Some(xmax)) = (
+            spans.iter().map(|s| s.1).min(),
+            spans.iter().map(|s| s.2).max(),
+        ) else {
+            continue;
         };
-        match &r.poly {
-            Some(poly) => scan_polygon(poly, view.width, rows, &mut visit),
-            None => {
-                for y in rows.0..=rows.1 {
-                    for x in 0..view.width {
-                        visit(x, y);
+        for t in xmin / TILE_W..=xmax / TILE_W {
+            let Some((lo, hi)) = tiles[t as usize] else {
+                continue;
+            };
+            if r.planes.iter().any(|p| p.max_over(lo, hi) < 0.0) {
+                continue;
+            }
+            if let Some(f) = &r.fold
+                && !fold_possible_in(f, lo, hi, slack)
+            {
+                continue;
+            }
+            let (c0, c1) = (t * TILE_W, (t * TILE_W + TILE_W - 1).min(view.width - 1));
+            for &(y, x0, x1) in &spans {
+                for x in x0.max(c0)..=x1.min(c1) {
+                    let i = y as usize * w + x as usize;
+                    scanned += 1;
+                    if !active[i] {
+                        continue;
+                    }
+                    let o = origins[i].as_dvec3();
+                    if r.planes.iter().any(|p| p.eval(o) < 0.0) {
+                        continue;
+                    }
+                    if let Some((f1, f2)) = &r.fold {
+                        let (g1, g2) = (f1.eval(o), f2.eval(o));
+                        if !((g1 > -slack && g2 > -slack) || (g1 < slack && g2 < slack)) {
+                            continue;
+                        }
+                    }
+                    if let Some(k) = e.sweep_weight(o, c, false)
+                        && k != 0
+                    {
+                        let k = k.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+                        found.push(((i - first) as u32, r.edge, k));
                     }
                 }
             }
@@ -290,48 +505,40 @@ fn convex_hull(mut p: Vec<DVec2>) -> Vec<DVec2> {
 /// Slack in pixels around wedge polygons.
 const PAD: f64 = 0.01;
 
-/// Visits the pixels of rows `rows` whose centres lie inside (or within [`PAD`] of) the convex
-/// polygon `poly`.
-fn scan_polygon(poly: &[DVec2], width: u32, rows: (u32, u32), visit: &mut impl FnMut(u32, u32)) {
-    let Some((y0, y1)) = polygon_rows(poly, u32::MAX) else {
-        return;
-    };
-    let (y0, y1) = (y0.max(rows.0), y1.min(rows.1));
+/// The pixels of row `y` whose centres lie inside (or within [`PAD`] of) the convex polygon
+/// `poly`, as an inclusive column range.
+fn row_span(poly: &[DVec2], y: u32, width: u32) -> Option<(u32, u32)> {
     let n = poly.len();
-    for y in y0..=y1 {
-        let yc = y as f64 + 0.5;
-        let (mut xl, mut xr) = (f64::INFINITY, f64::NEG_INFINITY);
-        if n < 3 {
-            for p in poly {
-                xl = xl.min(p.x);
-                xr = xr.max(p.x);
-            }
-        }
-        for i in 0..n {
-            let (a, b) = (poly[i], poly[(i + 1) % n]);
-            if yc < a.y.min(b.y) - PAD || yc > a.y.max(b.y) + PAD {
-                continue;
-            }
-            if (b.y - a.y).abs() < 1e-12 {
-                xl = xl.min(a.x.min(b.x));
-                xr = xr.max(a.x.max(b.x));
-            } else {
-                let t = ((yc - a.y) / (b.y - a.y)).clamp(0.0, 1.0);
-                let x = a.x + (b.x - a.x) * t;
-                xl = xl.min(x);
-                xr = xr.max(x);
-            }
-        }
-        if !(xl <= xr) {
-            continue;
-        }
-        let x0 = (xl - PAD - 0.5).ceil().max(0.0);
-        let x1 = (xr + PAD - 0.5).floor().min(width as f64 - 1.0);
-        if x0 > x1 {
-            continue;
-        }
-        for x in x0 as u32..=x1 as u32 {
-            visit(x, y);
+    if n == 0 {
+        return None;
+    }
+    let yc = y as f64 + 0.5;
+    let (mut xl, mut xr) = (f64::INFINITY, f64::NEG_INFINITY);
+    if n < 3 {
+        for p in poly {
+            xl = xl.min(p.x);
+            xr = xr.max(p.x);
         }
     }
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[(i + 1) % n]);
+        if yc < a.y.min(b.y) - PAD || yc > a.y.max(b.y) + PAD {
+            continue;
+        }
+        if (b.y - a.y).abs() < 1e-12 {
+            xl = xl.min(a.x.min(b.x));
+            xr = xr.max(a.x.max(b.x));
+        } else {
+            let t = ((yc - a.y) / (b.y - a.y)).clamp(0.0, 1.0);
+            let x = a.x + (b.x - a.x) * t;
+            xl = xl.min(x);
+            xr = xr.max(x);
+        }
+    }
+    if !(xl <= xr) {
+        return None;
+    }
+    let x0 = (xl - PAD - 0.5).ceil().max(0.0);
+    let x1 = (xr + PAD - 0.5).floor().min(width as f64 - 1.0);
+    (x0 <= x1).then_some((x0 as u32, x1 as u32))
 }

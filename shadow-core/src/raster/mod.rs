@@ -173,7 +173,10 @@ pub fn for_each_covered_pixel(view: &RasterView, tri: [Vec3; 3], mut f: impl FnM
     let v = tri.map(|p| view.view_from_world.transform_point3(p));
     for st in setup_triangle(v, view) {
         for y in st.ymin..=st.ymax {
-            for x in st.xmin..=st.xmax {
+            let Some((x0, x1)) = st.row_candidates(y) else {
+                continue;
+            };
+            for x in x0..=x1 {
                 if st.covers(x, y) {
                     f(x, y);
                 }

@@ -49,6 +49,35 @@ impl ScreenTriangle {
         self.weights_at(x, y).is_some()
     }
 
+    /// The columns of row `y` that may be covered: the interval where every edge function is
+    /// non-negative at the row's centre line, widened by a pixel on each side so that the exact
+    /// test ([`ScreenTriangle::covers`]) decides at the ends. `None` when the row misses.
+    pub fn row_candidates(&self, y: u32) -> Option<(u32, u32)> {
+        let yc = y as f64 + 0.5;
+        let (mut lo, mut hi) = (self.xmin as f64, self.xmax as f64 + 1.0);
+        for i in 0..3 {
+            let (a, b) = (self.p[i], self.p[(i + 1) % 3]);
+            // edge(a, b, (x, yc)) = (b.x - a.x)(yc - a.y) - (b.y - a.y)(x - a.x) >= 0.
+            let k = -(b.y - a.y);
+            let c0 = (b.x - a.x) * (yc - a.y) + (b.y - a.y) * a.x;
+            if k == 0.0 {
+                if c0 < 0.0 {
+                    return None;
+                }
+                continue;
+            }
+            let x = -c0 / k;
+            if k > 0.0 {
+                lo = lo.max(x - 0.5);
+            } else {
+                hi = hi.min(x - 0.5);
+            }
+        }
+        let x0 = (lo.floor() - 1.0).max(self.xmin as f64);
+        let x1 = (hi.ceil() + 1.0).min(self.xmax as f64);
+        (x0 <= x1).then_some((x0 as u32, x1 as u32))
+    }
+
     /// Linear depth at the centre of pixel `(x, y)` when covered.
     pub fn depth_at_center(&self, x: u32, y: u32) -> Option<f32> {
         let w = self.weights_at(x, y)?;
