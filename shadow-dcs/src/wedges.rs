@@ -189,6 +189,19 @@ fn neg(p: Plane) -> Plane {
 /// Per-tile bounds of the active view samples: tiles of [`TILE_W`] columns by one band of rows.
 pub(crate) const TILE_W: u32 = 4;
 
+/// Tiles per group: a group's box is tested before its tiles'.
+const GROUP: usize = 8;
+
+/// The union of tile boxes.
+fn union_boxes(boxes: &[TileBox]) -> TileBox {
+    boxes.iter().flatten().fold(None, |acc, (lo, hi)| {
+        Some(match acc {
+            Some((a, b)) => (lo.min(a), hi.max(b)),
+            None => (*lo, *hi),
+        })
+    })
+}
+
 /// `None` for a tile with no active view sample.
 pub(crate) type TileBox = Option<(DVec3, DVec3)>;
 
@@ -293,10 +306,29 @@ pub(crate) fn band_pairs(
     let mut found: Vec<(u32, u32, i32)> = Vec::new();
     let mut scanned = 0u64;
     let tiles = band_tiles(view, rows, origins, active);
+    let groups: Vec<TileBox> = tiles.chunks(GROUP).map(union_boxes).collect();
+    let band_box = union_boxes(&groups);
     let slack = FOLD_SLACK * scale;
+    let Some((band_lo, band_hi)) = band_box else {
+        return WedgePairs {
+            first,
+            start: vec![0; n + 1],
+            entries: Vec::new(),
+            scanned: 0,
+        };
+    };
+    let rejects = |r: &Region, lo: DVec3, hi: DVec3| -> bool {
+        r.planes.iter().any(|p| p.max_over(lo, hi) < 0.0)
+            || r.fold
+                .as_ref()
+                .is_some_and(|f| !fold_possible_in(f, lo, hi, slack))
+    };
     let mut spans: Vec<(u32, u32, u32)> = Vec::with_capacity(4);
     for r in regions {
         if r.rows.1 < rows.0 || r.rows.0 > rows.1 {
+            continue;
+        }
+        if rejects(r, band_lo, band_hi) {
             continue;
         }
         let e = &edges[r.edge as usize];
@@ -316,16 +348,22 @@ pub(crate) fn band_pairs(
         ) else {
             continue;
         };
+        let mut group_ok = (u32::MAX, false);
         for t in xmin / TILE_W..=xmax / TILE_W {
+            let g = t / GROUP as u32;
+            if group_ok.0 != g {
+                group_ok = (
+                    g,
+                    groups[g as usize].is_some_and(|(lo, hi)| !rejects(r, lo, hi)),
+                );
+            }
+            if !group_ok.1 {
+                continue;
+            }
             let Some((lo, hi)) = tiles[t as usize] else {
                 continue;
             };
-            if r.planes.iter().any(|p| p.max_over(lo, hi) < 0.0) {
-                continue;
-            }
-            if let Some(f) = &r.fold
-                && !fold_possible_in(f, lo, hi, slack)
-            {
+            if rejects(r, lo, hi) {
                 continue;
             }
             let (c0, c1) = (t * TILE_W, (t * TILE_W + TILE_W - 1).min(view.width - 1));
