@@ -17,8 +17,9 @@ pub const DCS_64_SEMI: &[(&str, [f64; 5])] =
 pub const DCS_256_SEMI: &[(&str, [f64; 5])] =
     &[("semi-opaque", [0.0226, 0.0336, -0.0074, 0.144, 0.0148])];
 
-/// `dcs-64-interleaved`.
-pub const DCS_64_INTERLEAVED: &[(&str, [f64; 5])] = &[
+/// `dcs-64-discrete` (the paper's tables alone; measured as `dcs-64-interleaved` before that
+/// preset took the tables with exact borders, same samples).
+pub const DCS_64_DISCRETE: &[(&str, [f64; 5])] = &[
     ("quad-over-plane", [0.0080, 0.0201, 0.0001, 0.156, 0.0024]),
     (
         "overlapping-occluders",
@@ -55,3 +56,7 @@ pub const DCS_STANDARD: &[(&str, [f64; 5])] = &[
     ("textured-light", [0.0269, 0.0269, -0.0038, 0.653, 0.0123]),
     ("sphere-light", [0.0389, 0.0737, 0.0020, 1.000, 0.0114]),
 ];
+
+/// `dcs-64-interleaved` (tables with exact borders): semi-opaque only.
+pub const DCS_64_INTERLEAVED_SEMI: &[(&str, [f64; 5])] =
+    &[("semi-opaque", [0.0225, 0.0336, -0.0074, 0.144, 0.0146])];

@@ -95,6 +95,21 @@ impl EdgeTest {
         self.covers_relative(d.x, d.y, d.z)
     }
 
+    /// Adds to `mask` the samples of `subset` the edge covers.
+    pub fn add_covered(&self, samples: &RelativeSamples, subset: &[u64], mask: &mut [u64]) {
+        for (w, (word, sub)) in mask.iter_mut().zip(subset).enumerate() {
+            let mut todo = *sub;
+            while todo != 0 {
+                let k = todo.trailing_zeros() as usize;
+                todo &= todo - 1;
+                let i = w * 64 + k;
+                if self.covers_relative(samples.x[i], samples.y[i], samples.z[i]) {
+                    *word |= 1 << k;
+                }
+            }
+        }
+    }
+
     /// Sets in `mask` the bits of the samples the edge covers, restricted to `allowed`;
     /// returns whether any is set.
     pub fn mask(&self, samples: &RelativeSamples, allowed: &[u64], mask: &mut [u64]) -> bool {

@@ -438,7 +438,7 @@ impl Dcs {
             };
             counts.edge_tests += 1;
             let any = match (&self.covered, &p.tables) {
-                (CoveredSamples::Discrete, Some(t)) => t.mask(
+                (CoveredSamples::Discrete | CoveredSamples::Refined, Some(t)) => t.mask(
                     s.pixel,
                     &test,
                     o,
@@ -634,9 +634,17 @@ impl ShadowTechnique for Dcs {
         stats.add("edges", edges.len() as u64);
         stats.add("silhouette-edges", sil.len() as u64);
         let tables = match self.covered {
-            CoveredSamples::Discrete => Some(stats.time("discrete-tables", || {
-                DiscreteTables::build(&self.sampler, light.as_ref(), &shape, &self.name)
-            })?),
+            CoveredSamples::Discrete | CoveredSamples::Refined => {
+                Some(stats.time("discrete-tables", || {
+                    DiscreteTables::build(
+                        &self.sampler,
+                        light.as_ref(),
+                        &shape,
+                        self.covered == CoveredSamples::Refined,
+                        &self.name,
+                    )
+                })?)
+            }
             CoveredSamples::Exact => None,
         };
         let extent = scene.bounds().union(light.bounds()).diagonal();

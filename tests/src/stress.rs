@@ -42,10 +42,10 @@ pub const KNOWN_LIMITATIONS: &[(&str, &str, &str)] = &[
          penumbra (DCS Fig. 4, the artifact the preset exists to show)",
     ),
     (
-        "dcs-64-interleaved",
+        "dcs-64-discrete",
         "light-larger-than-scene",
         "the line table of DCS section 7.3 spans the light's square, so on a light 300 times \
-         the occluder one cell is wider than the projected occluder; the exact mode holds",
+         the occluder one cell is wider than the projected occluder; the exact and refined modes hold",
     ),
 ];
 
