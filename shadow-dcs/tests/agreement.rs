@@ -176,3 +176,44 @@ fn remaining_disagreements_are_numerical_ties() {
     assert!(pairs > 10_000);
     assert!(differ as f64 <= 1e-3 * pairs as f64, "{differ} of {pairs}");
 }
+
+#[test]
+fn concave_polygon_lights_and_every_sampling_strategy_agree_with_the_reference() {
+    let setup = shadow_core::scenes::builtin("bunny").unwrap();
+    let view = view_of(&setup, 40, 30);
+    let c = setup.lights[0].center();
+    // An L-shaped light facing down, 1.2 across, at the scene light's centre.
+    let mut outline: Vec<Vec3> = [
+        (0.0, 0.0),
+        (1.2, 0.0),
+        (1.2, 0.4),
+        (0.4, 0.4),
+        (0.4, 1.2),
+        (0.0, 1.2),
+    ]
+    .iter()
+    .map(|(x, z)| c + Vec3::new(x - 0.6, 0.0, z - 0.6))
+    .collect();
+    let mut light =
+        PolygonLight::new(outline.clone(), Radiance::constant(Vec3::ONE).unwrap()).unwrap();
+    if light.geometry().plane_normal().unwrap().y > 0.0 {
+        outline.reverse();
+        light = PolygonLight::new(outline, Radiance::constant(Vec3::ONE).unwrap()).unwrap();
+    }
+    let light: Light = std::sync::Arc::new(light);
+    for strategy in [
+        SamplingStrategy::Correlated,
+        SamplingStrategy::Decorrelated,
+        SamplingStrategy::Stratified,
+        SamplingStrategy::Interleaved { tile: 3 },
+    ] {
+        let mut dcs = Dcs::new(32, strategy, 4).unwrap();
+        let mut r = same_samples_reference(&dcs);
+        dcs.prepare(setup.scene.clone(), light.clone()).unwrap();
+        r.prepare(setup.scene.clone(), light.clone()).unwrap();
+        let (d, e) = (dcs.estimate(&view).unwrap(), r.estimate(&view).unwrap());
+        let m = compare(&d.visibility, &e.visibility).unwrap();
+        assert!(m.sample_agreement.unwrap() >= 0.9999, "{strategy:?}: {m:?}");
+        assert!(d.stats.counter("wedge-pairs") > 0);
+    }
+}
