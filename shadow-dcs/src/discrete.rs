@@ -223,7 +223,6 @@ impl DiscreteTables {
         pixel: UVec2,
         test: &EdgeTest,
         p: DVec3,
-        _c: DVec3,
         edge: &SceneEdge,
         relative: &RelativeSamples,
         allowed: &[u64],
@@ -363,8 +362,8 @@ mod tests {
             let allowed = [u64::MAX];
             let (mut exact, mut fine, mut coarse) = ([0u64], [0u64], [0u64]);
             test.mask(&rel, &allowed, &mut exact);
-            refined.mask(pixel, &test, p, c, &edge, &rel, &allowed, &mut fine);
-            plain.mask(pixel, &test, p, c, &edge, &rel, &allowed, &mut coarse);
+            refined.mask(pixel, &test, p, &edge, &rel, &allowed, &mut fine);
+            plain.mask(pixel, &test, p, &edge, &rel, &allowed, &mut coarse);
             assert_eq!(fine, exact, "case {k}");
             total += 64;
             covered += exact[0].count_ones();

@@ -237,7 +237,6 @@ impl Dcs {
                 .into(),
         })?;
         let n = view.len();
-        let valid = view.valid_mask();
         let origins: Vec<Vec3> = (0..n)
             .map(|i| match view.get(i) {
                 Some(s) => p.offset.offset(s.position, s.geometric_normal),
@@ -282,7 +281,6 @@ impl Dcs {
         });
         stats.add("wedges", regions.len() as u64);
         stats.add("wedges-unbounded", unbounded);
-        drop(valid);
         Ok(Frame {
             origins,
             horizon,
@@ -442,7 +440,6 @@ impl Dcs {
                     s.pixel,
                     &test,
                     o,
-                    c,
                     edge,
                     &scratch.relative,
                     &scratch.above,
