@@ -34,6 +34,7 @@ pub fn registry() -> Vec<Preset> {
     let mut all = Vec::new();
     all.extend(shadow_ref::presets());
     all.extend(shadow_dcs::presets());
+    all.extend(shadow_ssm::presets());
     all
 }
 

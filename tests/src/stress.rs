@@ -213,9 +213,18 @@ fn rmse_common(a: &VisibilityImage, b: &VisibilityImage) -> f64 {
 pub fn technique_cases(preset: &Preset, width: u32, height: u32) -> Vec<StressResult> {
     let name = preset.name;
     let mut out = Vec::new();
-    // Against the reference: twice the preset's own RMSE budget on quad-over-plane. Invariance
-    // under scaling and translation: 0.02 RMSE for every technique.
-    let tol = (preset.budget)("quad-over-plane").map_or(0.05, |b| b.rmse.max(0.01) * 2.0);
+    // Against the reference: twice the largest RMSE the preset admits on a built-in scene with
+    // opaque occluders and a constant light (semi-opaque and textured-light errors measure
+    // other approximations), at least 0.02: an approximate technique is held to the error it
+    // declares somewhere, not to its best case. Invariance under scaling and translation: 0.02
+    // RMSE for every technique.
+    let tol = shadow_core::scenes::BUILTIN_SCENES
+        .iter()
+        .filter(|s| !matches!(**s, "semi-opaque" | "textured-light"))
+        .filter_map(|s| (preset.budget)(s))
+        .map(|b| b.rmse)
+        .fold(None, |m: Option<f64>, r| Some(m.map_or(r, |m| m.max(r))))
+        .map_or(0.05, |r| r.max(0.01) * 2.0);
     let invariance = 0.02;
     let base = builtin("quad-over-plane").expect("built-in");
     let view_of = |s: &SceneSetup| {

@@ -1,0 +1,55 @@
+//! Measured error tables of the shadow-map presets against the stratified reference at 1024
+//! samples (scene, [rmse, penumbra rmse, bias, max, share > 0.1]; 128 x 96, seed 1), from
+//! `cargo xtask conformance --techniques pcf,pcss` (2026-11-22), and their measured false-shadow
+//! shares (reference-lit pixels darkened by more than 0.1: shadow-map aliasing at contacts and
+//! silhouettes).
+
+/// `pcf`.
+pub const PCF: &[(&str, [f64; 5])] = &[
+    ("quad-over-plane", [0.1105, 0.2760, 0.0006, 0.705, 0.1161]),
+    (
+        "overlapping-occluders",
+        [0.1699, 0.2747, 0.0054, 0.724, 0.2778],
+    ),
+    ("large-light-close", [0.1972, 0.2248, 0.0376, 0.737, 0.4387]),
+    ("bunny", [0.0948, 0.2566, -0.0053, 0.801, 0.0959]),
+    ("spot-self-shadow", [0.1178, 0.2347, -0.0041, 0.667, 0.1782]),
+    ("grass", [0.0812, 0.2081, -0.0019, 0.680, 0.0986]),
+    ("contact", [0.0532, 0.1573, -0.0021, 0.548, 0.0432]),
+];
+
+/// `pcf` false-shadow shares.
+pub const PCF_FALSE_SHADOW: &[(&str, f64)] = &[
+    ("quad-over-plane", 0.0000),
+    ("overlapping-occluders", 0.0000),
+    ("large-light-close", 0.0000),
+    ("bunny", 0.0072),
+    ("spot-self-shadow", 0.0030),
+    ("grass", 0.0001),
+    ("contact", 0.0008),
+];
+
+/// `pcss`.
+pub const PCSS: &[(&str, [f64; 5])] = &[
+    ("quad-over-plane", [0.0061, 0.0151, 0.0001, 0.047, 0.0000]),
+    (
+        "overlapping-occluders",
+        [0.0254, 0.0353, 0.0047, 0.250, 0.0151],
+    ),
+    ("large-light-close", [0.0620, 0.0706, 0.0168, 0.640, 0.0560]),
+    ("bunny", [0.0552, 0.1247, -0.0032, 0.797, 0.0461]),
+    ("spot-self-shadow", [0.0445, 0.0795, -0.0006, 0.794, 0.0251]),
+    ("grass", [0.0701, 0.1168, 0.0108, 0.639, 0.0504]),
+    ("contact", [0.0380, 0.0850, -0.0016, 0.504, 0.0316]),
+];
+
+/// `pcss` false-shadow shares.
+pub const PCSS_FALSE_SHADOW: &[(&str, f64)] = &[
+    ("quad-over-plane", 0.0000),
+    ("overlapping-occluders", 0.0000),
+    ("large-light-close", 0.0000),
+    ("bunny", 0.0079),
+    ("spot-self-shadow", 0.0032),
+    ("grass", 0.0005),
+    ("contact", 0.0032),
+];

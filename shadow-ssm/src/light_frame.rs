@@ -1,0 +1,130 @@
+//! A planar light as shadow mapping sees it: its centre, emission axis, in-plane basis, outline
+//! (a polygon; a disk as a regular 64-gon inside which the error is below 0.2% of its area) and
+//! width, plus the exact fraction of the light above a receiver's tangent plane.
+
+use glam::{DVec3, Vec3};
+use shadow_core::light::{AreaLight, LightGeometry};
+use shadow_core::technique::TechniqueError;
+
+/// Sides of the polygon standing for a disk light.
+const DISK_SIDES: usize = 64;
+
+/// A planar light's frame.
+#[derive(Debug, Clone)]
+pub struct LightFrame {
+    /// Centre (the shadow map's eye).
+    pub center: Vec3,
+    /// Unit emission normal (the shadow map's viewing axis).
+    pub axis: Vec3,
+    /// In-plane unit axes.
+    pub basis: (Vec3, Vec3),
+    /// Outline, counter-clockwise around `axis`.
+    pub outline: Vec<Vec3>,
+    /// Width `w_l` of GBP07 eq. 1: the largest extent of the outline along the basis axes.
+    pub width: f32,
+}
+
+impl LightFrame {
+    /// The frame of a planar light.
+    ///
+    /// # Errors
+    /// [`TechniqueError::Unsupported`] for sphere and point lights.
+    pub fn new(light: &dyn AreaLight, technique: &str) -> Result<Self, TechniqueError> {
+        let (axis, outline) = match light.geometry() {
+            LightGeometry::Rectangle {
+                center,
+                half_u,
+                half_v,
+                normal,
+            } => (
+                normal,
+                vec![
+                    center - half_u - half_v,
+                    center + half_u - half_v,
+                    center + half_u + half_v,
+                    center - half_u + half_v,
+                ],
+            ),
+            LightGeometry::Polygon { outline, normal } => (normal, outline.to_vec()),
+            LightGeometry::Disk {
+                center,
+                normal,
+                radius,
+            } => {
+                let (t1, t2) = shadow_core::geometry::orthonormal_basis(normal);
+                let v = (0..DISK_SIDES)
+                    .map(|k| {
+                        let a = k as f32 * std::f32::consts::TAU / DISK_SIDES as f32;
+                        center + (t1 * a.cos() + t2 * a.sin()) * radius
+                    })
+                    .collect();
+                (normal, v)
+            }
+            LightGeometry::Sphere { .. } | LightGeometry::Point { .. } => {
+                return Err(TechniqueError::Unsupported {
+                    technique: technique.into(),
+                    reason: "shadow mapping needs a planar light (its near plane is parallel to \
+                             the light, GBP07 section 3); sphere and point lights have none"
+                        .into(),
+                });
+            }
+        };
+        let center = light.center();
+        let basis = shadow_core::geometry::orthonormal_basis(axis);
+        let extent = |t: Vec3| {
+            let (lo, hi) = outline
+                .iter()
+                .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), p| {
+                    let x = (*p - center).dot(t);
+                    (a.min(x), b.max(x))
+                });
+            hi - lo
+        };
+        let width = extent(basis.0).max(extent(basis.1));
+        Ok(Self {
+            center,
+            axis,
+            basis,
+            outline,
+            width,
+        })
+    }
+
+    /// The fraction of the light's area above the plane through `p` with normal `n` (the
+    /// part of the light a receiver can see at all; the reference counts the rest occluded).
+    pub fn fraction_above(&self, p: Vec3, n: Vec3) -> f32 {
+        let (t1, t2) = (self.basis.0.as_dvec3(), self.basis.1.as_dvec3());
+        let c = self.center.as_dvec3();
+        let side = |q: DVec3| (q - p.as_dvec3()).dot(n.as_dvec3());
+        let pts: Vec<DVec3> = self.outline.iter().map(|v| v.as_dvec3()).collect();
+        let area = |poly: &[DVec3]| -> f64 {
+            let m = poly.len();
+            let mut s = 0.0;
+            for i in 0..m {
+                let (a, b) = (poly[i] - c, poly[(i + 1) % m] - c);
+                s += a.dot(t1) * b.dot(t2) - b.dot(t1) * a.dot(t2);
+            }
+            (0.5 * s).abs()
+        };
+        let total = area(&pts);
+        if !(total > 0.0) {
+            return 0.0;
+        }
+        // Sutherland-Hodgman against the half-space side > 0.
+        let mut clipped = Vec::with_capacity(pts.len() + 2);
+        for i in 0..pts.len() {
+            let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
+            let (sa, sb) = (side(a), side(b));
+            if sa > 0.0 {
+                clipped.push(a);
+            }
+            if (sa > 0.0) != (sb > 0.0) {
+                clipped.push(a + (b - a) * (sa / (sa - sb)));
+            }
+        }
+        if clipped.len() < 3 {
+            return 0.0;
+        }
+        ((area(&clipped) / total) as f32).clamp(0.0, 1.0)
+    }
+}

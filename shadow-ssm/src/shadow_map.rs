@@ -1,0 +1,161 @@
+//! The shadow map of soft shadow mapping (GBP07 section 3, Fig. 2a): the scene seen from the
+//! light's centre through a perspective frustum whose near plane and borders are parallel to
+//! the light, storing linear depth (distance from the light's plane along its axis).
+//!
+//! The frustum is fitted to the view samples that can see the light, widened so that every
+//! occluder able to shadow them is inside: an occluder at depth `d` shadows a receiver at depth
+//! `z_p` only within `w_l / 2 (1/d - 1/z_p)` of it at unit depth (the pyramid of GBP07 eq. 1),
+//! so the receivers' bounds grow by `w_l / (2 z_min)` (at most doubling them), `z_min` being the
+//! nearest scene depth in front of the light.
+
+use glam::{Affine3A, Vec3};
+use shadow_core::raster::{Projection, RasterError, RasterView, rasterize};
+use shadow_core::scene::Scene;
+
+use crate::light_frame::LightFrame;
+
+/// A light-centre shadow map.
+#[derive(Debug, Clone)]
+pub struct ShadowMap {
+    /// The light's frustum.
+    pub view: RasterView,
+    /// Linear depth per texel (infinite where nothing was drawn), row-major, row 0 on top.
+    pub depth: Vec<f32>,
+    /// Texels per unit of unit-depth coordinates (`r / w_n * z_n` of GBP07 eq. 1).
+    pub texels_per_unit: f64,
+    /// Smallest depth stored (the top of GBP07's hierarchical shadow map).
+    pub min_depth: f32,
+}
+
+impl ShadowMap {
+    /// Renders the shadow map of `scene` for `frame` at `resolution` texels a side, fitted to
+    /// `receivers` (world positions). `None` when no receiver lies in front of the light.
+    ///
+    /// # Errors
+    /// [`RasterError`] for an invalid resolution.
+    pub fn render(
+        scene: &dyn Scene,
+        frame: &LightFrame,
+        receivers: &[Vec3],
+        resolution: u32,
+    ) -> Result<Option<Self>, RasterError> {
+        // View space looks down -Z along the light's axis; x, y span the light's plane.
+        let (mut x, mut y) = frame.basis;
+        if x.cross(y).dot(frame.axis) > 0.0 {
+            std::mem::swap(&mut x, &mut y);
+        }
+        let world_from_view = Affine3A::from_cols(
+            x.into(),
+            y.into(),
+            (-frame.axis).into(),
+            frame.center.into(),
+        );
+        let view_from_world = world_from_view.inverse();
+        let extent = scene.bounds().diagonal().max(f32::MIN_POSITIVE);
+        // The nearest geometry in front of the light plane sets the near plane and the margin.
+        let z_min_scene = scene
+            .positions()
+            .iter()
+            .map(|p| -view_from_world.transform_point3(*p).z)
+            .filter(|d| *d > 0.0)
+            .fold(f32::INFINITY, f32::min);
+        let near = (1e-3 * extent).min(0.5 * z_min_scene).max(1e-7 * extent);
+        let (mut lo, mut hi) = (
+            glam::Vec2::splat(f32::INFINITY),
+            glam::Vec2::splat(f32::NEG_INFINITY),
+        );
+        for p in receivers {
+            let v = view_from_world.transform_point3(*p);
+            let d = -v.z;
+            if d > near {
+                let q = glam::Vec2::new(v.x / d, v.y / d);
+                lo = lo.min(q);
+                hi = hi.max(q);
+            }
+        }
+        if !(lo.x <= hi.x) {
+            return Ok(None);
+        }
+        let size = (hi - lo).max_element().max(1e-6);
+        let margin = (frame.width / (2.0 * z_min_scene.max(near))).min(size);
+        // A square frustum (square texels), centred on the receivers.
+        let mid = (lo + hi) * 0.5;
+        let half = size * 0.5 + margin;
+        let view = RasterView {
+            width: resolution,
+            height: resolution,
+            view_from_world,
+            projection: Projection::Perspective {
+                left: mid.x - half,
+                right: mid.x + half,
+                bottom: mid.y - half,
+                top: mid.y + half,
+                near,
+            },
+        };
+        let frags = rasterize(scene.positions(), scene.triangles(), &view, 1)?;
+        let min_depth = frags.depth.iter().copied().fold(f32::INFINITY, f32::min);
+        Ok(Some(Self {
+            view,
+            depth: frags.depth,
+            texels_per_unit: resolution as f64 / (2.0 * half as f64),
+            min_depth,
+        }))
+    }
+
+    /// Texel coordinates (continuous, texel centres at `i + 0.5`) and linear depth of `p`, or
+    /// `None` when `p` is not in front of the near plane.
+    pub fn project(&self, p: Vec3) -> Option<(f64, f64, f32)> {
+        let v = self.view.view_from_world.transform_point3(p);
+        let d = -v.z;
+        let (l, _, _, t, near, _) = self.view.extents();
+        if !(d > near) {
+            return None;
+        }
+        let x = (v.x / d - l) as f64 * self.texels_per_unit;
+        let y = (t - v.y / d) as f64 * self.texels_per_unit;
+        Some((x, y, d))
+    }
+
+    /// Depth of texel `(x, y)`, infinite outside the map.
+    #[inline]
+    pub fn at(&self, x: i64, y: i64) -> f32 {
+        let r = self.view.width as i64;
+        if x < 0 || y < 0 || x >= r || y >= r {
+            f32::INFINITY
+        } else {
+            self.depth[(y * r + x) as usize]
+        }
+    }
+
+    /// The depth of the plane through `p` with normal `n` at each texel centre (infinite where
+    /// the ray through the texel does not meet the plane in front of the light).
+    pub fn receiver_plane(&self, p: Vec3, n: Vec3) -> impl Fn(i64, i64) -> f32 + use<> {
+        let v = &self.view.view_from_world;
+        let (pv, nv) = (
+            v.transform_point3(p).as_dvec3(),
+            v.transform_vector3(n).as_dvec3(),
+        );
+        let np = nv.dot(pv);
+        let (l, _, _, t, _, _) = self.view.extents();
+        let (l, t, tpu) = (l as f64, t as f64, self.texels_per_unit);
+        move |ix: i64, iy: i64| {
+            // The texel centre's ray at unit depth is (u, v, -1); at depth d it is d (u, v, -1).
+            let u = l + (ix as f64 + 0.5) / tpu;
+            let w = t - (iy as f64 + 0.5) / tpu;
+            let den = nv.x * u + nv.y * w - nv.z;
+            let d = np / den;
+            if den != 0.0 && d > 0.0 {
+                d as f32
+            } else {
+                f32::INFINITY
+            }
+        }
+    }
+
+    /// Width in texels of the region holding the occluders of a receiver at depth `z_p` that
+    /// lie at depth `z` or further (GBP07 eq. 1): `w_l r z_n / w_n (1/z - 1/z_p)`.
+    pub fn kernel_width(&self, light_width: f32, z: f32, z_p: f32) -> f64 {
+        light_width as f64 * self.texels_per_unit * (1.0 / z as f64 - 1.0 / z_p as f64).max(0.0)
+    }
+}
