@@ -1,7 +1,8 @@
 //! # shadow-ssm
 //!
 //! Shadow-map soft shadows. This first part of the soft shadow mapping family holds the
-//! light-centre shadow map of GBP07 section 3 ([`shadow_map`]) and the single-sample baselines a
+//! light-centre shadow map of GBP07 section 3 ([`shadow_map`]), its hierarchical min/max version
+//! with GBP07's converging kernel ([`hierarchy`]), and the single-sample baselines a
 //! renderer would otherwise pick, PCF and PCSS ([`technique`]); back-projection (GBP06),
 //! depth peeling (BCS06), contours and the adaptive scheme (GBP07 sections 4 and 5) build on the
 //! same map.
@@ -21,6 +22,7 @@
 #![deny(missing_docs)]
 
 mod budgets;
+pub mod hierarchy;
 pub mod light_frame;
 mod presets;
 pub mod shadow_map;

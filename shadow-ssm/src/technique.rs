@@ -5,7 +5,8 @@
 //! * **PCF** (percentage-closer filtering): the share of a fixed square of texels around the
 //!   receiver's projection whose depth is not in front of the receiver.
 //! * **PCSS** (percentage-closer soft shadows): a blocker search over the region that can hold
-//!   the receiver's occluders (GBP07 eq. 1 with the map's minimum depth), the mean depth `z_b`
+//!   the receiver's occluders (GBP07 eq. 1, shrunk with the min/max pyramid until it converges;
+//!   a receiver with nothing in front of it in that region is lit at once), the mean depth `z_b`
 //!   of the blockers found, then PCF over the penumbra width that eq. 1 gives for `z_b`.
 //!
 //! Both multiply by the exact fraction of the light above the receiver's tangent plane, the
@@ -24,6 +25,7 @@ use shadow_core::prelude::*;
 use shadow_core::technique::{Capabilities, Processor, SceneRef};
 use shadow_core::visibility::PixelClass;
 
+use crate::hierarchy::MinMaxPyramid;
 use crate::light_frame::LightFrame;
 use crate::shadow_map::ShadowMap;
 
@@ -104,6 +106,7 @@ impl ShadowMapFilter {
     fn lit(
         &self,
         sm: &ShadowMap,
+        pyramid: &MinMaxPyramid,
         frame: &LightFrame,
         x: f64,
         y: f64,
@@ -133,9 +136,13 @@ impl ShadowMapFilter {
                 lit as f32 / ((2 * r + 1) * (2 * r + 1)) as f32
             }
             Filter::Pcss => {
-                let search = sm
-                    .kernel_width(frame.width, sm.min_depth, z)
-                    .clamp(1.0, MAX_WIDTH);
+                // The search region: eq. 1, shrunk with the pyramid's local minimum until it
+                // converges (GBP07 section 3); nothing in front of the receiver means lit.
+                let (search, local_min) = pyramid.converged_kernel(sm, frame.width, x, y, z);
+                if !(local_min < z - bias) {
+                    return 1.0;
+                }
+                let search = search.clamp(1.0, MAX_WIDTH);
                 let (mut sum, mut count) = (0.0f64, 0u32);
                 taps(sm, x, y, search, |d, ix, iy| {
                     if occludes(d, ix, iy) {
@@ -226,6 +233,7 @@ impl ShadowTechnique for ShadowMapFilter {
         let sm = stats.time("shadow-map", || {
             ShadowMap::render(p.scene.as_ref(), &p.frame, &receivers, self.resolution)
         })?;
+        let pyramid = stats.time("min-max-pyramid", || sm.as_ref().map(MinMaxPyramid::build));
         let w = view.width() as usize;
         struct Row {
             v: Vec<f32>,
@@ -254,17 +262,18 @@ impl ShadowTechnique for ShadowMapFilter {
                         }
                         let projected = sm
                             .as_ref()
-                            .and_then(|m| m.project(origins[i]).map(|q| (m, q)));
+                            .zip(pyramid.as_ref())
+                            .and_then(|(m, h)| m.project(origins[i]).map(|q| (m, h, q)));
                         let lit = match projected {
                             None => {
                                 r.outside += 1;
                                 1.0
                             }
-                            Some((m, (tx, ty, z))) => {
+                            Some((m, h, (tx, ty, z))) => {
                                 let plane = m.receiver_plane(origins[i], s.geometric_normal);
                                 let texel = z / m.texels_per_unit as f32;
                                 let bias = texel + 1e-6 * p.extent;
-                                self.lit(m, &p.frame, tx, ty, z, bias, &plane)
+                                self.lit(m, h, &p.frame, tx, ty, z, bias, &plane)
                             }
                         };
                         let v = (lit * h).clamp(0.0, 1.0);
