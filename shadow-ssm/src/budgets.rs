@@ -53,3 +53,28 @@ pub const PCSS_FALSE_SHADOW: &[(&str, f64)] = &[
     ("grass", 0.0002),
     ("contact", 0.0019),
 ];
+
+/// `ssm-backprojection`.
+pub const BACKPROJECTION: &[(&str, [f64; 5])] = &[
+    ("quad-over-plane", [0.0040, 0.0098, 0.0002, 0.033, 0.0000]),
+    (
+        "overlapping-occluders",
+        [0.0248, 0.0350, -0.0003, 0.329, 0.0158],
+    ),
+    ("large-light-close", [0.0647, 0.0737, 0.0179, 0.643, 0.0646]),
+    ("bunny", [0.0398, 0.1031, -0.0057, 0.502, 0.0353]),
+    ("spot-self-shadow", [0.0353, 0.0672, -0.0107, 0.725, 0.0162]),
+    ("grass", [0.0417, 0.0994, -0.0052, 0.793, 0.0233]),
+    ("contact", [0.0270, 0.0774, -0.0040, 0.690, 0.0188]),
+];
+
+/// `ssm-backprojection` false-shadow shares.
+pub const BACKPROJECTION_FALSE_SHADOW: &[(&str, f64)] = &[
+    ("quad-over-plane", 0.0000),
+    ("overlapping-occluders", 0.0000),
+    ("large-light-close", 0.0000),
+    ("bunny", 0.0006),
+    ("spot-self-shadow", 0.0000),
+    ("grass", 0.0001),
+    ("contact", 0.0001),
+];

@@ -21,6 +21,7 @@
 
 #![deny(missing_docs)]
 
+pub mod backprojection;
 mod budgets;
 pub mod hierarchy;
 pub mod light_frame;

@@ -4,6 +4,7 @@
 
 use shadow_core::prelude::*;
 
+use crate::backprojection::Backprojection;
 use crate::budgets;
 use crate::{Filter, ShadowMapFilter};
 
@@ -41,6 +42,28 @@ pub fn presets() -> Vec<Preset> {
             description: "PCSS: blocker search (GBP07 eq. 1), then PCF of the penumbra width, 1024^2 map",
             make: |_| Box::new(ShadowMapFilter::new("pcss", Filter::Pcss, RESOLUTION)),
             budget: |s| budget(budgets::PCSS, budgets::PCSS_FALSE_SHADOW, s),
+            with_samples: None,
+        },
+        Preset {
+            name: "ssm-backprojection",
+            description: "Soft shadow mapping by back-projection with gap filling (GBP06), converged kernel, at most 1024 samples per pixel, 1024^2 map",
+            make: |_| {
+                Box::new(ShadowMapFilter::new(
+                    "ssm-backprojection",
+                    Filter::Backprojection(Backprojection {
+                        max_nspp: 1024,
+                        gap_filling: true,
+                    }),
+                    RESOLUTION,
+                ))
+            },
+            budget: |s| {
+                budget(
+                    budgets::BACKPROJECTION,
+                    budgets::BACKPROJECTION_FALSE_SHADOW,
+                    s,
+                )
+            },
             with_samples: None,
         },
     ]

@@ -25,6 +25,7 @@ use shadow_core::prelude::*;
 use shadow_core::technique::{Capabilities, Processor, SceneRef};
 use shadow_core::visibility::PixelClass;
 
+use crate::backprojection::{Backprojection, LightOutline};
 use crate::hierarchy::MinMaxPyramid;
 use crate::light_frame::LightFrame;
 use crate::shadow_map::ShadowMap;
@@ -33,6 +34,8 @@ use crate::shadow_map::ShadowMap;
 pub const MAX_TAPS: u32 = 16;
 /// Largest PCSS search or filter width, in texels.
 pub const MAX_WIDTH: f64 = 256.0;
+/// Largest back-projection kernel, in texels (the stride keeps its cost at `max_nspp`).
+pub const MAX_KERNEL: f64 = 1024.0;
 
 /// Which filter turns the shadow map into soft shadows.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -44,6 +47,8 @@ pub enum Filter {
     },
     /// Blocker search, then PCF of the width the blockers' mean depth gives.
     Pcss,
+    /// Back-projection of the occluding samples onto the light (GBP06).
+    Backprojection(Backprojection),
 }
 
 struct Prepared {
@@ -107,6 +112,7 @@ impl ShadowMapFilter {
         &self,
         sm: &ShadowMap,
         pyramid: &MinMaxPyramid,
+        outline: &LightOutline,
         frame: &LightFrame,
         x: f64,
         y: f64,
@@ -157,6 +163,15 @@ impl ShadowMapFilter {
                 pcf(sm
                     .kernel_width(frame.width, blocker, z)
                     .clamp(1.0, MAX_WIDTH))
+            }
+            Filter::Backprojection(bp) => {
+                let (kernel, local_min) = pyramid.converged_kernel(sm, frame.width, x, y, z);
+                if !(local_min < z - bias) {
+                    return 1.0;
+                }
+                let kernel = kernel.clamp(1.0, MAX_KERNEL);
+                let (occluded, _) = bp.occluded(sm, outline, x, y, z, kernel, &occludes);
+                (1.0 - occluded).clamp(0.0, 1.0) as f32
             }
         }
     }
@@ -234,6 +249,15 @@ impl ShadowTechnique for ShadowMapFilter {
             ShadowMap::render(p.scene.as_ref(), &p.frame, &receivers, self.resolution)
         })?;
         let pyramid = stats.time("min-max-pyramid", || sm.as_ref().map(MinMaxPyramid::build));
+        let outline = sm.as_ref().map(|m| {
+            let pts: Vec<glam::Vec2> = p
+                .frame
+                .outline
+                .iter()
+                .map(|v| m.view.view_from_world.transform_point3(*v).truncate())
+                .collect();
+            LightOutline::new(&pts)
+        });
         let w = view.width() as usize;
         struct Row {
             v: Vec<f32>,
@@ -262,7 +286,7 @@ impl ShadowTechnique for ShadowMapFilter {
                         }
                         let projected = sm
                             .as_ref()
-                            .zip(pyramid.as_ref())
+                            .zip(pyramid.as_ref().zip(outline.as_ref()))
                             .and_then(|(m, h)| m.project(origins[i]).map(|q| (m, h, q)));
                         let lit = match projected {
                             None => {
@@ -273,7 +297,7 @@ impl ShadowTechnique for ShadowMapFilter {
                                 let plane = m.receiver_plane(origins[i], s.geometric_normal);
                                 let texel = z / m.texels_per_unit as f32;
                                 let bias = texel + 1e-6 * p.extent;
-                                self.lit(m, h, &p.frame, tx, ty, z, bias, &plane)
+                                self.lit(m, h.0, h.1, &p.frame, tx, ty, z, bias, &plane)
                             }
                         };
                         let v = (lit * h).clamp(0.0, 1.0);
