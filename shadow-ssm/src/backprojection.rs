@@ -88,12 +88,19 @@ fn polygon_area(p: &[DVec2]) -> f64 {
 }
 
 /// Settings of one back-projection.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Backprojection {
     /// Largest number of samples read per receiver.
     pub max_nspp: u32,
     /// Extend samples to their occluding neighbours (GBP06).
     pub gap_filling: bool,
+    /// Depth peeling (BCS06 section 4): the map's layers are read deepest first, a layer
+    /// occludes when its midpoint with the next layer (capped at this many world units beyond
+    /// it, Fig. 5b) is in front of the receiver, and the first layer whose back-projection
+    /// covers part of the light is used; a layer must also pass the caller's depth test
+    /// (against the receiver's tangent plane), since a sample in that plane cannot hide light
+    /// above the horizon. `None` reads layer 0 with the caller's depth test alone.
+    pub peeling_max_bias: Option<f32>,
 }
 
 impl Backprojection {
@@ -121,11 +128,7 @@ impl Backprojection {
         let (x0, y0) = ((x - half).floor() as i64, (y - half).floor() as i64);
         let (x1, y1) = ((x + half).floor() as i64, (y + half).floor() as i64);
         // The light-plane rectangle a texel back-projects to, if it occludes.
-        let rect = |ix: i64, iy: i64| -> Option<(DVec2, DVec2)> {
-            let zs = sm.at(ix, iy);
-            if !occludes(zs, ix, iy) {
-                return None;
-            }
+        let project = |ix: i64, iy: i64, zs: f32| -> Option<(DVec2, DVec2)> {
             let zs = zs as f64;
             let scale = z / (z - zs);
             if !(scale > 0.0) || !scale.is_finite() {
@@ -136,6 +139,44 @@ impl Backprojection {
             // Texel size at depth zs (times the stride), back-projected.
             let h = 0.5 * step as f64 * zs / tpu * scale;
             Some((c - DVec2::splat(h), c + DVec2::splat(h)))
+        };
+        let rect = |ix: i64, iy: i64| -> Option<(DVec2, DVec2)> {
+            match self.peeling_max_bias {
+                None => {
+                    let zs = sm.at(ix, iy);
+                    if occludes(zs, ix, iy) {
+                        project(ix, iy, zs)
+                    } else {
+                        None
+                    }
+                }
+                Some(cap) => {
+                    let zf = z as f32;
+                    for k in (0..sm.layers).rev() {
+                        let d = sm.layer_at(ix, iy, k);
+                        if !d.is_finite() {
+                            continue;
+                        }
+                        let next = sm.layer_at(ix, iy, k + 1);
+                        let mid = if next.is_finite() {
+                            (0.5 * (d + next)).min(d + cap)
+                        } else {
+                            d + cap
+                        };
+                        // The midpoint decides self-shadowing; a layer on or behind the receiver's
+                        // tangent plane (the caller's test) cannot hide light above its horizon.
+                        if !(mid < zf) || !occludes(d, ix, iy) {
+                            continue;
+                        }
+                        if let Some((lo, hi)) = project(ix, iy, d)
+                            && light.clipped_area(lo, hi) > 0.0
+                        {
+                            return Some((lo, hi));
+                        }
+                    }
+                    None
+                }
+            }
         };
         let mut sum = 0.0;
         let mut read = 0u64;
@@ -191,9 +232,11 @@ mod tests {
                     near: 0.1,
                 },
             },
-            depth,
+            depth: depth.clone(),
             texels_per_unit: 4.0,
             min_depth: 1.0,
+            layers: 1,
+            layered: depth,
         };
         let light = LightOutline::new(&[
             Vec2::new(-0.5, -0.5),
@@ -206,6 +249,7 @@ mod tests {
             let bp = Backprojection {
                 max_nspp: 64,
                 gap_filling,
+                peeling_max_bias: None,
             };
             let (f, read) = bp.occluded(&sm, &light, 4.5, 4.5, 2.0, 8.0, &occludes);
             assert!((f - 0.25).abs() < 1e-12, "{f}");
@@ -215,6 +259,7 @@ mod tests {
         let bp = Backprojection {
             max_nspp: 16,
             gap_filling: false,
+            peeling_max_bias: None,
         };
         let (f, _) = bp.occluded(&sm, &light, 4.5, 4.5, 2.0, 8.0, &occludes);
         assert!((f - 1.0).abs() < 1e-12, "{f}");

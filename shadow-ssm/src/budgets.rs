@@ -78,3 +78,31 @@ pub const BACKPROJECTION_FALSE_SHADOW: &[(&str, f64)] = &[
     ("grass", 0.0001),
     ("contact", 0.0001),
 ];
+
+/// `ssm-peeling`.
+pub const PEELING: &[(&str, [f64; 5])] = &[
+    ("quad-over-plane", [0.0040, 0.0098, 0.0002, 0.033, 0.0000]),
+    (
+        "overlapping-occluders",
+        [0.0297, 0.0479, -0.0063, 0.263, 0.0287],
+    ),
+    (
+        "large-light-close",
+        [0.0727, 0.0828, -0.0270, 0.418, 0.0938],
+    ),
+    ("bunny", [0.0520, 0.1420, -0.0102, 0.596, 0.0547]),
+    ("spot-self-shadow", [0.0775, 0.1553, -0.0319, 0.458, 0.1389]),
+    ("grass", [0.0640, 0.0946, 0.0262, 0.845, 0.0913]),
+    ("contact", [0.0427, 0.1259, -0.0079, 0.690, 0.0331]),
+];
+
+/// `ssm-peeling` false-shadow shares.
+pub const PEELING_FALSE_SHADOW: &[(&str, f64)] = &[
+    ("quad-over-plane", 0.0000),
+    ("overlapping-occluders", 0.0000),
+    ("large-light-close", 0.0000),
+    ("bunny", 0.0000),
+    ("spot-self-shadow", 0.0000),
+    ("grass", 0.0001),
+    ("contact", 0.0001),
+];

@@ -117,7 +117,7 @@ mod tests {
     use shadow_core::sampling::{hash_words, unit_float};
 
     fn random_map(r: u32) -> ShadowMap {
-        let depth = (0..r * r)
+        let depth: Vec<f32> = (0..r * r)
             .map(|i| {
                 let h = hash_words(&[7, i as u64]);
                 if h.is_multiple_of(11) {
@@ -140,9 +140,11 @@ mod tests {
                     near: 0.1,
                 },
             },
-            depth,
+            depth: depth.clone(),
             texels_per_unit: r as f64 / 2.0,
             min_depth: 1.0,
+            layers: 1,
+            layered: depth,
         }
     }
 

@@ -53,6 +53,7 @@ pub fn presets() -> Vec<Preset> {
                     Filter::Backprojection(Backprojection {
                         max_nspp: 1024,
                         gap_filling: true,
+                        peeling_max_bias: None,
                     }),
                     RESOLUTION,
                 ))
@@ -66,5 +67,26 @@ pub fn presets() -> Vec<Preset> {
             },
             with_samples: None,
         },
+        Preset {
+            name: "ssm-peeling",
+            description: "Soft shadow mapping with 3 depth-peeled layers and midpoint depths (BCS06 section 4), no gap filling, 1024^2 map",
+            make: |_| {
+                Box::new(ShadowMapFilter::new(
+                    "ssm-peeling",
+                    Filter::Backprojection(Backprojection {
+                        max_nspp: 1024,
+                        gap_filling: false,
+                        peeling_max_bias: Some(PEELING_MAX_BIAS),
+                    }),
+                    RESOLUTION,
+                ))
+            },
+            budget: |s| budget(budgets::PEELING, budgets::PEELING_FALSE_SHADOW, s),
+            with_samples: None,
+        },
     ]
 }
+
+/// The cap on a midpoint's distance beyond its layer (BCS06 Fig. 5b), in world units: about a
+/// tenth of the built-in scenes' occluder heights.
+pub const PEELING_MAX_BIAS: f32 = 0.05;

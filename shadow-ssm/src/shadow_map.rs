@@ -25,6 +25,11 @@ pub struct ShadowMap {
     pub texels_per_unit: f64,
     /// Smallest depth stored (the top of GBP07's hierarchical shadow map).
     pub min_depth: f32,
+    /// Depth-peeled layers (BCS06 section 4.1): `layers` depths per texel, nearest first,
+    /// strictly increasing, infinite where the beam hits fewer surfaces; `depth` is layer 0.
+    pub layers: u32,
+    /// The layered depths, `layers` per texel.
+    pub layered: Vec<f32>,
 }
 
 impl ShadowMap {
@@ -38,6 +43,7 @@ impl ShadowMap {
         frame: &LightFrame,
         receivers: &[Vec3],
         resolution: u32,
+        layers: u32,
     ) -> Result<Option<Self>, RasterError> {
         // View space looks down -Z along the light's axis; x, y span the light's plane.
         let (mut x, mut y) = frame.basis;
@@ -93,11 +99,17 @@ impl ShadowMap {
                 near,
             },
         };
-        let frags = rasterize(scene.positions(), scene.triangles(), &view, 1)?;
-        let min_depth = frags.depth.iter().copied().fold(f32::INFINITY, f32::min);
+        let layers = layers.max(1);
+        let frags = rasterize(scene.positions(), scene.triangles(), &view, layers)?;
+        let first: Vec<f32> = (0..(resolution * resolution) as usize)
+            .map(|i| frags.depth[i * layers as usize])
+            .collect();
+        let min_depth = first.iter().copied().fold(f32::INFINITY, f32::min);
         Ok(Some(Self {
             view,
-            depth: frags.depth,
+            depth: first,
+            layers,
+            layered: frags.depth,
             texels_per_unit: resolution as f64 / (2.0 * half as f64),
             min_depth,
         }))
@@ -115,6 +127,17 @@ impl ShadowMap {
         let x = (v.x / d - l) as f64 * self.texels_per_unit;
         let y = (t - v.y / d) as f64 * self.texels_per_unit;
         Some((x, y, d))
+    }
+
+    /// Depth of layer `k` of texel `(x, y)`, infinite outside the map.
+    #[inline]
+    pub fn layer_at(&self, x: i64, y: i64, k: u32) -> f32 {
+        let r = self.view.width as i64;
+        if x < 0 || y < 0 || x >= r || y >= r || k >= self.layers {
+            f32::INFINITY
+        } else {
+            self.layered[(y * r + x) as usize * self.layers as usize + k as usize]
+        }
     }
 
     /// Depth of texel `(x, y)`, infinite outside the map.

@@ -63,6 +63,7 @@ pub struct ShadowMapFilter {
     name: String,
     filter: Filter,
     resolution: u32,
+    peeling_layers: u32,
     prepared: Option<Prepared>,
 }
 
@@ -99,8 +100,27 @@ impl ShadowMapFilter {
             name: name.into(),
             filter,
             resolution,
+            peeling_layers: 3,
             prepared: None,
         }
+    }
+
+    /// Shadow-map layers the filter reads.
+    fn layers(&self) -> u32 {
+        match self.filter {
+            Filter::Backprojection(Backprojection {
+                peeling_max_bias: Some(_),
+                ..
+            }) => self.peeling_layers,
+            _ => 1,
+        }
+    }
+
+    /// Sets the number of depth-peeled layers (BCS06 uses 3, the default).
+    #[must_use]
+    pub fn with_layers(mut self, layers: u32) -> Self {
+        self.peeling_layers = layers.max(1);
+        self
     }
 
     /// The unoccluded share seen by a receiver at texel `(x, y)`, depth `z`, whose tangent
@@ -246,7 +266,13 @@ impl ShadowTechnique for ShadowMapFilter {
             .map(|i| origins[i])
             .collect();
         let sm = stats.time("shadow-map", || {
-            ShadowMap::render(p.scene.as_ref(), &p.frame, &receivers, self.resolution)
+            ShadowMap::render(
+                p.scene.as_ref(),
+                &p.frame,
+                &receivers,
+                self.resolution,
+                self.layers(),
+            )
         })?;
         let pyramid = stats.time("min-max-pyramid", || sm.as_ref().map(MinMaxPyramid::build));
         let outline = sm.as_ref().map(|m| {

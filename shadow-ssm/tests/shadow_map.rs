@@ -48,9 +48,13 @@ fn shadow_map_depths_equal_the_distance_to_the_light_plane_and_eq1_holds() {
     let receivers: Vec<Vec3> = (-10..=10)
         .flat_map(|i| (-10..=10).map(move |j| Vec3::new(i as f32 * 0.2, 0.0, j as f32 * 0.2)))
         .collect();
-    let sm = ShadowMap::render(&scene, &frame, &receivers, 256)
+    let sm = ShadowMap::render(&scene, &frame, &receivers, 256, 2)
         .unwrap()
         .unwrap();
+    // Two layers: the occluder, then the floor, straight below the light.
+    let (x0, y0, _) = sm.project(Vec3::ZERO).unwrap();
+    assert!((sm.layer_at(x0 as i64, y0 as i64, 0) - 2.5).abs() < 1e-4);
+    assert!((sm.layer_at(x0 as i64, y0 as i64, 1) - 4.0).abs() < 1e-4);
     // Straight below the light: the occluder at depth 2.5; far out: the floor at depth 4.
     let (x, y, z) = sm.project(Vec3::new(0.0, 0.0, 0.0)).unwrap();
     assert!((z - 4.0).abs() < 1e-4);
