@@ -13,79 +13,10 @@
 //! * At most `max_nspp` samples per receiver: beyond, the kernel is read with a uniform stride
 //!   and each sample's size is scaled by the stride (BCS06 section 5).
 
-use glam::{DVec2, Vec2};
+use glam::DVec2;
 
+use crate::light_domain::{Covered, LightDomain};
 use crate::shadow_map::ShadowMap;
-
-/// The light's outline in the shadow map's view plane (x, y of view space; the light lies at
-/// depth 0), with its area.
-#[derive(Debug, Clone)]
-pub struct LightOutline {
-    points: Vec<DVec2>,
-    area: f64,
-}
-
-impl LightOutline {
-    /// From outline points in view space.
-    pub fn new(points: &[Vec2]) -> Self {
-        let points: Vec<DVec2> = points.iter().map(|p| p.as_dvec2()).collect();
-        let area = polygon_area(&points).abs();
-        Self { points, area }
-    }
-
-    /// Area of the light.
-    pub fn area(&self) -> f64 {
-        self.area
-    }
-
-    /// Area of the light inside the axis-aligned rectangle `lo..hi`.
-    pub fn clipped_area(&self, lo: DVec2, hi: DVec2) -> f64 {
-        if !(lo.x < hi.x && lo.y < hi.y) {
-            return 0.0;
-        }
-        let mut poly = self.points.clone();
-        let mut next = Vec::with_capacity(poly.len() + 4);
-        // Sutherland-Hodgman against x >= lo.x, x <= hi.x, y >= lo.y, y <= hi.y.
-        for (axis, bound, keep_above) in [
-            (0, lo.x, true),
-            (0, hi.x, false),
-            (1, lo.y, true),
-            (1, hi.y, false),
-        ] {
-            next.clear();
-            let inside = |p: DVec2| {
-                let c = if axis == 0 { p.x } else { p.y };
-                if keep_above { c >= bound } else { c <= bound }
-            };
-            for i in 0..poly.len() {
-                let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
-                let (ia, ib) = (inside(a), inside(b));
-                if ia {
-                    next.push(a);
-                }
-                if ia != ib {
-                    let (ca, cb) = if axis == 0 { (a.x, b.x) } else { (a.y, b.y) };
-                    let t = (bound - ca) / (cb - ca);
-                    next.push(a + (b - a) * t);
-                }
-            }
-            std::mem::swap(&mut poly, &mut next);
-            if poly.len() < 3 {
-                return 0.0;
-            }
-        }
-        polygon_area(&poly).abs()
-    }
-}
-
-fn polygon_area(p: &[DVec2]) -> f64 {
-    let n = p.len();
-    let mut s = 0.0;
-    for i in 0..n {
-        s += p[i].perp_dot(p[(i + 1) % n]);
-    }
-    0.5 * s
-}
 
 /// Settings of one back-projection.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -106,18 +37,19 @@ pub struct Backprojection {
 impl Backprojection {
     /// The occluded fraction of the light seen from a receiver at texel coordinates `(x, y)`,
     /// depth `z`, through a kernel of `width` texels; `occludes(depth, ix, iy)` is the biased
-    /// depth test of a texel. Returns the fraction (not clamped) and the samples read.
+    /// depth test of a texel. Returns the occluded part of the light (area and, for a textured
+    /// light, radiance; overlaps may exceed the light) and the samples read.
     #[allow(clippy::too_many_arguments)]
     pub fn occluded(
         &self,
         sm: &ShadowMap,
-        light: &LightOutline,
+        light: &LightDomain,
         x: f64,
         y: f64,
         z: f32,
         width: f64,
         occludes: &impl Fn(f32, i64, i64) -> bool,
-    ) -> (f64, u64) {
+    ) -> (Covered, u64) {
         let (l, _, _, t, _, _) = sm.view.extents();
         let (l, t, tpu, z) = (l as f64, t as f64, sm.texels_per_unit, z as f64);
         // The receiver in view space (unit-depth coordinates times depth).
@@ -178,7 +110,7 @@ impl Backprojection {
                 }
             }
         };
-        let mut sum = 0.0;
+        let mut sum = Covered::default();
         let mut read = 0u64;
         let mut iy = y0;
         while iy <= y1 {
@@ -195,20 +127,20 @@ impl Backprojection {
                             hi.y = hi.y.max(nlo.y);
                         }
                     }
-                    sum += light.clipped_area(lo, hi);
+                    sum += light.rect(lo, hi);
                 }
                 ix += step;
             }
             iy += step;
         }
-        (sum / light.area().max(f64::MIN_POSITIVE), read)
+        (sum, read)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Affine3A;
+    use glam::{Affine3A, Vec2};
     use shadow_core::raster::{Projection, RasterView};
 
     /// BCS06 eq. 1 by hand: an 8 x 8 map over unit-depth [-1, 1]^2 (4 texels per unit), one
@@ -238,7 +170,7 @@ mod tests {
             layers: 1,
             layered: depth,
         };
-        let light = LightOutline::new(&[
+        let light = LightDomain::new(&[
             Vec2::new(-0.5, -0.5),
             Vec2::new(0.5, -0.5),
             Vec2::new(0.5, 0.5),
@@ -251,7 +183,8 @@ mod tests {
                 gap_filling,
                 peeling_max_bias: None,
             };
-            let (f, read) = bp.occluded(&sm, &light, 4.5, 4.5, 2.0, 8.0, &occludes);
+            let (c, read) = bp.occluded(&sm, &light, 4.5, 4.5, 2.0, 8.0, &occludes);
+            let f = c.area / light.area();
             assert!((f - 0.25).abs() < 1e-12, "{f}");
             assert!(read >= 64);
         }
@@ -261,26 +194,11 @@ mod tests {
             gap_filling: false,
             peeling_max_bias: None,
         };
-        let (f, _) = bp.occluded(&sm, &light, 4.5, 4.5, 2.0, 8.0, &occludes);
+        let f = bp
+            .occluded(&sm, &light, 4.5, 4.5, 2.0, 8.0, &occludes)
+            .0
+            .area
+            / light.area();
         assert!((f - 1.0).abs() < 1e-12, "{f}");
-    }
-
-    #[test]
-    fn clipped_area_of_a_square_light() {
-        let l = LightOutline::new(&[
-            Vec2::new(-0.5, -0.5),
-            Vec2::new(0.5, -0.5),
-            Vec2::new(0.5, 0.5),
-            Vec2::new(-0.5, 0.5),
-        ]);
-        assert!((l.area() - 1.0).abs() < 1e-12);
-        let a = l.clipped_area(DVec2::new(0.0, 0.0), DVec2::new(2.0, 2.0));
-        assert!((a - 0.25).abs() < 1e-12);
-        let a = l.clipped_area(DVec2::new(-0.1, -0.2), DVec2::new(0.1, 0.2));
-        assert!((a - 0.08).abs() < 1e-12);
-        assert_eq!(
-            l.clipped_area(DVec2::new(1.0, 1.0), DVec2::new(2.0, 2.0)),
-            0.0
-        );
     }
 }

@@ -35,6 +35,34 @@ impl MinMaxPyramid {
         Self { levels }
     }
 
+    /// Level `k`: side in texels and the min depths (row-major).
+    pub fn level(&self, k: usize) -> (usize, &[f32]) {
+        let (side, lo, _) = &self.levels[k.min(self.levels.len() - 1)];
+        (*side, lo)
+    }
+
+    /// The min depth of level `k` filtered bilinearly at level-0 texel coordinates `(x, y)`,
+    /// each tap clamped to `cap` (GBP07 section 5.1's continuous occluder depth: `cap` is the
+    /// receiver's depth, so texels with no occluder count as no penumbra).
+    pub fn filtered_min(&self, k: usize, x: f64, y: f64, cap: f32) -> f32 {
+        let (side, lo) = self.level(k);
+        let s = (1u64 << k.min(62)) as f64;
+        let (fx, fy) = (x / s - 0.5, y / s - 0.5);
+        let (ix, iy) = (fx.floor(), fy.floor());
+        let (tx, ty) = ((fx - ix) as f32, (fy - iy) as f32);
+        let at = |i: f64, j: f64| -> f32 {
+            let (i, j) = (i as i64, j as i64);
+            if i < 0 || j < 0 || i >= side as i64 || j >= side as i64 {
+                cap
+            } else {
+                lo[j as usize * side + i as usize].min(cap)
+            }
+        };
+        let top = at(ix, iy) * (1.0 - tx) + at(ix + 1.0, iy) * tx;
+        let bottom = at(ix, iy + 1.0) * (1.0 - tx) + at(ix + 1.0, iy + 1.0) * tx;
+        top * (1.0 - ty) + bottom * ty
+    }
+
     /// Number of levels (level 0 is the shadow map).
     pub fn level_count(&self) -> usize {
         self.levels.len()

@@ -23,11 +23,17 @@
 
 pub mod backprojection;
 mod budgets;
+pub mod contours;
 pub mod hierarchy;
+pub mod light_domain;
 pub mod light_frame;
+pub mod light_space;
 mod presets;
+pub mod screen_space;
 pub mod shadow_map;
 pub mod technique;
 
+pub use light_space::Contours;
 pub use presets::presets;
+pub use screen_space::ScreenSpace;
 pub use technique::{Filter, ShadowMapFilter};

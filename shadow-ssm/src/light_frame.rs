@@ -20,7 +20,8 @@ pub struct LightFrame {
     pub basis: (Vec3, Vec3),
     /// Outline, counter-clockwise around `axis`.
     pub outline: Vec<Vec3>,
-    /// Width `w_l` of GBP07 eq. 1: the largest extent of the outline along the basis axes.
+    /// Width `w_l` of GBP07 eq. 1: twice the outline's largest reach from the centre along the
+    /// basis axes.
     pub width: f32,
 }
 
@@ -71,14 +72,13 @@ impl LightFrame {
         };
         let center = light.center();
         let basis = shadow_core::geometry::orthonormal_basis(axis);
+        // Twice the farthest reach from the centre, so a kernel centred on a receiver's
+        // projection covers the light even when the centre is off its middle.
         let extent = |t: Vec3| {
-            let (lo, hi) = outline
+            2.0 * outline
                 .iter()
-                .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), p| {
-                    let x = (*p - center).dot(t);
-                    (a.min(x), b.max(x))
-                });
-            hi - lo
+                .map(|p| (*p - center).dot(t).abs())
+                .fold(0.0f32, f32::max)
         };
         let width = extent(basis.0).max(extent(basis.1));
         Ok(Self {

@@ -6,7 +6,7 @@ use shadow_core::prelude::*;
 
 use crate::backprojection::Backprojection;
 use crate::budgets;
-use crate::{Filter, ShadowMapFilter};
+use crate::{Contours, Filter, ScreenSpace, ShadowMapFilter};
 
 /// The measured budget of `scene`, its false-shadow bound included (measured share plus 25%
 /// and 0.002, as [`Budget::from_measured`] treats the share over 0.1).
@@ -84,8 +84,51 @@ pub fn presets() -> Vec<Preset> {
             budget: |s| budget(budgets::PEELING, budgets::PEELING_FALSE_SHADOW, s),
             with_samples: None,
         },
+        Preset {
+            name: "ssm-contours",
+            description: "Soft shadow mapping with contour edges (t = 0) integrated radially (GBP07 section 4), kernels above 256 texels on coarser levels, 1024^2 map",
+            make: |_| {
+                Box::new(ShadowMapFilter::new(
+                    "ssm-contours",
+                    Filter::Contours(CONTOURS),
+                    RESOLUTION,
+                ))
+            },
+            budget: |s| budget(budgets::CONTOURS, budgets::CONTOURS_FALSE_SHADOW, s),
+            with_samples: None,
+        },
+        Preset {
+            name: "ssm-adaptive",
+            description: "Contours with light-space multi-resolution (t_k = 32, beta = 0.05) and screen-space selection (s_min = 16, 4x4 pattern) with pull-push (GBP07 section 5), 1024^2 map",
+            make: |_| {
+                Box::new(
+                    ShadowMapFilter::new("ssm-adaptive", Filter::Contours(ADAPTIVE), RESOLUTION)
+                        .with_screen_space(ScreenSpace {
+                            s_min: 16.0,
+                            pattern: 4,
+                        }),
+                )
+            },
+            budget: |s| budget(budgets::ADAPTIVE, budgets::ADAPTIVE_FALSE_SHADOW, s),
+            with_samples: None,
+        },
     ]
 }
+
+/// Contours at full resolution: `t = 0` (GBP07's recommendation); eq. 2 moves only kernels
+/// above 256 texels to a coarser level, so the cost per receiver stays bounded.
+pub const CONTOURS: Contours = Contours {
+    t: 0.0,
+    max_kernel: 256.0,
+    beta: 0.05,
+};
+
+/// The adaptive scheme's light-space settings: kernels of about 32 texels per level (16 loses thin occluders such as grass blades: RMSE 0.046 against 0.032 at 32).
+pub const ADAPTIVE: Contours = Contours {
+    t: 0.0,
+    max_kernel: 32.0,
+    beta: 0.05,
+};
 
 /// The cap on a midpoint's distance beyond its layer (BCS06 Fig. 5b), in world units: about a
 /// tenth of the built-in scenes' occluder heights.

@@ -151,9 +151,8 @@ impl ShadowMap {
         }
     }
 
-    /// The depth of the plane through `p` with normal `n` at each texel centre (infinite where
-    /// the ray through the texel does not meet the plane in front of the light).
-    pub fn receiver_plane(&self, p: Vec3, n: Vec3) -> impl Fn(i64, i64) -> f32 + use<> {
+    /// The plane through `p` with normal `n` as an inverse depth linear in texel coordinates.
+    pub fn inverse_plane(&self, p: Vec3, n: Vec3) -> InversePlane {
         let v = &self.view.view_from_world;
         let (pv, nv) = (
             v.transform_point3(p).as_dvec3(),
@@ -162,23 +161,55 @@ impl ShadowMap {
         let np = nv.dot(pv);
         let (l, _, _, t, _, _) = self.view.extents();
         let (l, t, tpu) = (l as f64, t as f64, self.texels_per_unit);
-        move |ix: i64, iy: i64| {
-            // The texel centre's ray at unit depth is (u, v, -1); at depth d it is d (u, v, -1).
-            let u = l + (ix as f64 + 0.5) / tpu;
-            let w = t - (iy as f64 + 0.5) / tpu;
-            let den = nv.x * u + nv.y * w - nv.z;
-            let d = np / den;
-            if den != 0.0 && d > 0.0 {
-                d as f32
-            } else {
-                f32::INFINITY
-            }
+        if np == 0.0 || !np.is_finite() {
+            return InversePlane::default();
         }
+        // The ray through texel point (X, Y) at unit depth is (u, w, -1), u = l + X / tpu,
+        // w = t - Y / tpu; it meets the plane at depth np / (nv.x u + nv.y w - nv.z).
+        InversePlane {
+            a: (nv.x * l + nv.y * t - nv.z) / np,
+            b: nv.x / tpu / np,
+            c: -nv.y / tpu / np,
+        }
+    }
+
+    /// The depth of the plane through `p` with normal `n` at each texel centre (infinite where
+    /// the ray through the texel does not meet the plane in front of the light).
+    pub fn receiver_plane(&self, p: Vec3, n: Vec3) -> impl Fn(i64, i64) -> f32 + use<> {
+        let plane = self.inverse_plane(p, n);
+        move |ix: i64, iy: i64| plane.depth(ix as f64 + 0.5, iy as f64 + 0.5, 0.0)
     }
 
     /// Width in texels of the region holding the occluders of a receiver at depth `z_p` that
     /// lie at depth `z` or further (GBP07 eq. 1): `w_l r z_n / w_n (1/z - 1/z_p)`.
     pub fn kernel_width(&self, light_width: f32, z: f32, z_p: f32) -> f64 {
         light_width as f64 * self.texels_per_unit * (1.0 / z as f64 - 1.0 / z_p as f64).max(0.0)
+    }
+}
+
+/// A plane's inverse depth along the shadow map's rays, `a + b X + c Y` at texel coordinates
+/// `(X, Y)` (texel centres at `i + 0.5`); perspective makes it linear, so its extremes over a
+/// block lie at the corners.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct InversePlane {
+    /// Value at texel coordinates (0, 0).
+    pub a: f64,
+    /// Slope along X.
+    pub b: f64,
+    /// Slope along Y.
+    pub c: f64,
+}
+
+impl InversePlane {
+    /// The smallest depth of the plane over the square of half-side `half` texels centred at
+    /// `(x, y)` (infinite where the plane lies behind the light or is missed).
+    #[inline]
+    pub fn depth(&self, x: f64, y: f64, half: f64) -> f32 {
+        let inv = self.a + self.b * x + self.c * y + (self.b.abs() + self.c.abs()) * half;
+        if inv > 0.0 {
+            (1.0 / inv) as f32
+        } else {
+            f32::INFINITY
+        }
     }
 }

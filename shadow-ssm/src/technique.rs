@@ -1,6 +1,7 @@
-//! Shadow-map techniques: PCF and PCSS, the single-sample baselines a renderer would otherwise
-//! pick (survey section 3.1.4 surveys the family), on the light-centre shadow map of GBP07
-//! section 3.
+//! Shadow-map techniques on the light-centre shadow map of GBP07 section 3: PCF and PCSS, the
+//! single-sample baselines a renderer would otherwise pick (survey section 3.1.4 surveys the
+//! family), back-projection (GBP06, with BCS06's depth peeling) and contours (GBP07 sections
+//! 4 and 5, with light- and screen-space multi-resolution).
 //!
 //! * **PCF** (percentage-closer filtering): the share of a fixed square of texels around the
 //!   receiver's projection whose depth is not in front of the receiver.
@@ -15,19 +16,29 @@
 //! wide kernels do not shadow a surface with itself. Wide kernels are
 //! sampled on at most `MAX_TAPS x MAX_TAPS` evenly spaced texels. Receivers outside the frustum
 //! (at or behind the light's plane) take the horizon fraction alone and are counted.
+//!
+//! Every receiver is first classified from the min/max pyramid over its converged kernel:
+//! nothing in front of it means lit (`pixels-skipped-lit`); for contours, every sample in front
+//! means umbra (`pixels-skipped-umbra`, the contours then have no edge and hide the centre).
+//! Only the rest is integrated; with screen-space selection some of those are left to pull-push
+//! (`pixels-reconstructed`).
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use serde_json::json;
 use shadow_core::light::LightKind;
 use shadow_core::offset::RayOffset;
 use shadow_core::prelude::*;
 use shadow_core::technique::{Capabilities, Processor, SceneRef};
-use shadow_core::visibility::PixelClass;
+use shadow_core::visibility::{Coefficients, PixelClass};
 
-use crate::backprojection::{Backprojection, LightOutline};
+use crate::backprojection::Backprojection;
+use crate::contours::{MapFrame, Receiver, Scratch};
 use crate::hierarchy::MinMaxPyramid;
+use crate::light_domain::{Covered, LightDomain, RadianceTable};
 use crate::light_frame::LightFrame;
+use crate::light_space::{self, Contours};
+use crate::screen_space::{self, ScreenSpace};
 use crate::shadow_map::ShadowMap;
 
 /// Largest number of taps per side of a filter or search square.
@@ -49,21 +60,32 @@ pub enum Filter {
     Pcss,
     /// Back-projection of the occluding samples onto the light (GBP06).
     Backprojection(Backprojection),
+    /// Contour edges integrated radially (GBP07 sections 4 and 5.1).
+    Contours(Contours),
+}
+
+impl Filter {
+    /// True when the filter integrates over the light's area (and so can weight by a texture).
+    fn integrates_the_light(&self) -> bool {
+        matches!(self, Self::Backprojection(_) | Self::Contours(_))
+    }
 }
 
 struct Prepared {
     scene: SceneRef,
+    light: Light,
     frame: LightFrame,
     offset: RayOffset,
     extent: f32,
 }
 
-/// PCF or PCSS on a light-centre shadow map.
+/// A soft-shadow filter on a light-centre shadow map.
 pub struct ShadowMapFilter {
     name: String,
     filter: Filter,
     resolution: u32,
     peeling_layers: u32,
+    screen_space: Option<ScreenSpace>,
     prepared: Option<Prepared>,
 }
 
@@ -73,6 +95,7 @@ impl std::fmt::Debug for ShadowMapFilter {
             .field("name", &self.name)
             .field("filter", &self.filter)
             .field("resolution", &self.resolution)
+            .field("screen_space", &self.screen_space)
             .finish()
     }
 }
@@ -93,6 +116,40 @@ fn taps(sm: &ShadowMap, x: f64, y: f64, width: f64, mut visit: impl FnMut(f32, i
     n * n
 }
 
+/// What the filter found at one receiver.
+enum Outcome {
+    /// Nothing in front of the receiver in its kernel.
+    Lit,
+    /// Every sample of the kernel in front (contours only).
+    Umbra,
+    /// Integrated: the unoccluded fraction of the light's area and radiance integral.
+    Integrated(Covered),
+    /// A single-sample filter's unoccluded fraction.
+    Fraction(f64),
+    /// Left to pull-push (screen-space selection).
+    Reconstruct,
+}
+
+/// Everything shared by the receivers of one estimate.
+struct Context<'a> {
+    sm: &'a ShadowMap,
+    pyramid: &'a MinMaxPyramid,
+    domain: &'a LightDomain,
+    frame: &'a LightFrame,
+    map_frame: MapFrame,
+    /// Screen-space selection: settings, pattern, discontinuity buffer, camera's pixels per unit.
+    selection: Option<(ScreenSpace, Vec<f32>, Vec<bool>, f32)>,
+}
+
+/// Per-receiver counters.
+#[derive(Default)]
+struct Counts {
+    edges: u64,
+    levels: u64,
+    blended: u64,
+    read: u64,
+}
+
 impl ShadowMapFilter {
     /// A technique with `filter` on a shadow map of `resolution` texels a side.
     pub fn new(name: &str, filter: Filter, resolution: u32) -> Self {
@@ -101,6 +158,7 @@ impl ShadowMapFilter {
             filter,
             resolution,
             peeling_layers: 3,
+            screen_space: None,
             prepared: None,
         }
     }
@@ -123,30 +181,38 @@ impl ShadowMapFilter {
         self
     }
 
-    /// The unoccluded share seen by a receiver at texel `(x, y)`, depth `z`, whose tangent
-    /// plane gives the depth `plane(ix, iy)` at each texel centre (receiver-plane depth bias:
-    /// a tap occludes when its depth is in front of the receiver's plane there by more than
-    /// `bias`, so wide kernels do not shadow a surface with itself).
+    /// Adds screen-space selection and pull-push (GBP07 section 5.2); it applies to the
+    /// contour filter, whose classification gives the occluder depth it needs.
+    #[must_use]
+    pub fn with_screen_space(mut self, s: ScreenSpace) -> Self {
+        self.screen_space = Some(s);
+        self
+    }
+
+    /// The filter's outcome for a receiver at texel `(x, y)`, depth `z`, whose tangent plane
+    /// gives the depth `plane(ix, iy)` at each texel centre (receiver-plane depth bias: a tap
+    /// occludes when its depth is in front of the receiver's plane there by more than `bias`,
+    /// so wide kernels do not shadow a surface with itself).
     #[allow(clippy::too_many_arguments)]
-    fn lit(
+    fn shade(
         &self,
-        sm: &ShadowMap,
-        pyramid: &MinMaxPyramid,
-        outline: &LightOutline,
-        frame: &LightFrame,
-        x: f64,
-        y: f64,
-        z: f32,
-        bias: f32,
-        plane: &impl Fn(i64, i64) -> f32,
-    ) -> f32 {
+        cx: &Context,
+        r: &Receiver,
+        pixel: (u32, u32, usize),
+        camera: (f32, f32),
+        scratch: &mut Scratch,
+        counts: &mut Counts,
+    ) -> Outcome {
+        let (sm, pyramid, frame) = (cx.sm, cx.pyramid, cx.frame);
+        let (x, y, z, bias) = (r.x, r.y, r.z, r.bias);
+        let plane = |ix: i64, iy: i64| r.plane.depth(ix as f64 + 0.5, iy as f64 + 0.5, 0.0);
         let occludes = |d: f32, ix: i64, iy: i64| d < plane(ix, iy) - bias;
-        let pcf = |width: f64| -> f32 {
+        let pcf = |width: f64| -> f64 {
             let mut lit = 0u32;
             let n = taps(sm, x, y, width, |d, ix, iy| {
                 lit += !occludes(d, ix, iy) as u32
             });
-            lit as f32 / n as f32
+            lit as f64 / n as f64
         };
         match self.filter {
             Filter::Pcf { radius } => {
@@ -159,14 +225,14 @@ impl ShadowMapFilter {
                         lit += !occludes(sm.at(ix, iy), ix, iy) as u32;
                     }
                 }
-                lit as f32 / ((2 * r + 1) * (2 * r + 1)) as f32
+                Outcome::Fraction(lit as f64 / ((2 * r + 1) * (2 * r + 1)) as f64)
             }
             Filter::Pcss => {
                 // The search region: eq. 1, shrunk with the pyramid's local minimum until it
                 // converges (GBP07 section 3); nothing in front of the receiver means lit.
                 let (search, local_min) = pyramid.converged_kernel(sm, frame.width, x, y, z);
                 if !(local_min < z - bias) {
-                    return 1.0;
+                    return Outcome::Lit;
                 }
                 let search = search.clamp(1.0, MAX_WIDTH);
                 let (mut sum, mut count) = (0.0f64, 0u32);
@@ -177,23 +243,80 @@ impl ShadowMapFilter {
                     }
                 });
                 if count == 0 {
-                    return 1.0;
+                    return Outcome::Lit;
                 }
                 let blocker = (sum / count as f64) as f32;
-                pcf(sm
+                Outcome::Fraction(pcf(sm
                     .kernel_width(frame.width, blocker, z)
-                    .clamp(1.0, MAX_WIDTH))
+                    .clamp(1.0, MAX_WIDTH)))
             }
             Filter::Backprojection(bp) => {
                 let (kernel, local_min) = pyramid.converged_kernel(sm, frame.width, x, y, z);
                 if !(local_min < z - bias) {
-                    return 1.0;
+                    return Outcome::Lit;
                 }
                 let kernel = kernel.clamp(1.0, MAX_KERNEL);
-                let (occluded, _) = bp.occluded(sm, outline, x, y, z, kernel, &occludes);
-                (1.0 - occluded).clamp(0.0, 1.0) as f32
+                let (occluded, read) = bp.occluded(sm, cx.domain, x, y, z, kernel, &occludes);
+                counts.read += read;
+                Outcome::Integrated(unoccluded(cx.domain, occluded))
+            }
+            Filter::Contours(c) => {
+                let (kernel, local_min) = pyramid.converged_kernel(sm, frame.width, x, y, z);
+                if !(local_min < z - bias) {
+                    return Outcome::Lit;
+                }
+                let kernel = kernel.max(1.0);
+                // Umbra: every sample of the kernel in front of the receiver's plane.
+                let h = 0.5 * kernel;
+                let (x0, y0, x1, y1) = (
+                    (x - h).floor() as i64 - 1,
+                    (y - h).floor() as i64 - 1,
+                    (x + h).floor() as i64 + 1,
+                    (y + h).floor() as i64 + 1,
+                );
+                let inside_map =
+                    x0 >= 0 && y0 >= 0 && x1 < sm.view.width as i64 && y1 < sm.view.height as i64;
+                if inside_map
+                    && let Some((_, max)) = pyramid.bounds(x0, y0, x1, y1)
+                    && max < r.plane.depth(x, y, h + 1.5) - bias
+                {
+                    return Outcome::Umbra;
+                }
+                let z_occ = light_space::occluder_depth(pyramid, kernel, x, y, z);
+                if let Some((s, pattern, disc, eta)) = &cx.selection {
+                    let (z_pe, n_dot_v) = camera;
+                    let s_scr =
+                        screen_space::penumbra_pixels(frame.width, z, z_occ, z_pe, n_dot_v, *eta);
+                    if !disc[pixel.2] && !s.selected(pattern, pixel.0, pixel.1, s_scr) {
+                        return Outcome::Reconstruct;
+                    }
+                }
+                let lambda = c.lambda(sm, frame.width, z_occ, z);
+                let (occluded, work) = c.occluded(
+                    pyramid,
+                    &cx.map_frame,
+                    r,
+                    kernel,
+                    lambda,
+                    cx.domain,
+                    scratch,
+                );
+                counts.edges += work.edges;
+                counts.levels += work.levels;
+                counts.blended += (work.levels > 1) as u64;
+                Outcome::Integrated(unoccluded(cx.domain, occluded))
             }
         }
+    }
+}
+
+/// The unoccluded part of the light, as fractions of its area: `(area, radiance / area)`.
+fn unoccluded(domain: &LightDomain, occluded: Covered) -> Covered {
+    let full = domain.full();
+    let a = full.area.max(f64::MIN_POSITIVE);
+    Covered {
+        area: ((full.area - occluded.area) / a).clamp(0.0, 1.0),
+        radiance: ((full.radiance - occluded.radiance) / a).max(DVec3::ZERO),
     }
 }
 
@@ -206,7 +329,7 @@ impl ShadowTechnique for ShadowMapFilter {
         Capabilities {
             lights: vec![LightKind::Rectangle, LightKind::Disk, LightKind::Polygon],
             semi_opaque: false,
-            textured_lights: false,
+            textured_lights: self.filter.integrates_the_light(),
             needs_closed_meshes: false,
             sample_based: false,
             processor: Processor::Cpu,
@@ -217,6 +340,7 @@ impl ShadowTechnique for ShadowMapFilter {
         json!({
             "filter": format!("{:?}", self.filter),
             "shadow_map_resolution": self.resolution,
+            "screen_space": self.screen_space.map(|s| format!("{s:?}")),
         })
     }
 
@@ -228,10 +352,17 @@ impl ShadowTechnique for ShadowMapFilter {
                 technique: self.name.clone(),
                 reason,
             })?;
+        if light.is_textured() && light.kind() != LightKind::Rectangle {
+            return Err(TechniqueError::Unsupported {
+                technique: self.name.clone(),
+                reason: "textured lights are integrated on rectangle lights only".into(),
+            });
+        }
         let frame = LightFrame::new(light.as_ref(), &self.name)?;
         let extent = scene.bounds().union(light.bounds()).diagonal();
         self.prepared = Some(Prepared {
             scene,
+            light,
             frame,
             offset: RayOffset::for_extent(extent),
             extent,
@@ -275,31 +406,98 @@ impl ShadowTechnique for ShadowMapFilter {
             )
         })?;
         let pyramid = stats.time("min-max-pyramid", || sm.as_ref().map(MinMaxPyramid::build));
-        let outline = sm.as_ref().map(|m| {
+        let textured = p.light.is_textured() && self.filter.integrates_the_light();
+        let domain = sm.as_ref().map(|m| {
+            let view_from_world = &m.view.view_from_world;
             let pts: Vec<glam::Vec2> = p
                 .frame
                 .outline
                 .iter()
-                .map(|v| m.view.view_from_world.transform_point3(*v).truncate())
+                .map(|v| view_from_world.transform_point3(*v).truncate())
                 .collect();
-            LightOutline::new(&pts)
+            let domain = LightDomain::new(&pts);
+            let world_from_view = view_from_world.inverse();
+            let table = textured
+                .then(|| {
+                    RadianceTable::new(
+                        p.light.as_ref(),
+                        world_from_view.transform_vector3(Vec3::X),
+                        world_from_view.transform_vector3(Vec3::Y),
+                    )
+                })
+                .flatten();
+            match table {
+                Some(t) => domain.with_texture(t),
+                None => domain,
+            }
         });
+        // The unshadowed value of a receiver: 1, or the light's mean radiance.
+        let mean_radiance = domain.as_ref().map_or(p.light.radiance().mean(), |d| {
+            (d.full().radiance / d.area().max(f64::MIN_POSITIVE)).as_vec3()
+        });
+        let camera = view.raster_view();
+        let (l, r, _, _, _, perspective) = camera.extents();
+        let eta = view.width() as f32 / (r - l);
+        let selection = match (self.screen_space, self.filter) {
+            (Some(s), Filter::Contours(_)) => Some(stats.time("discontinuities", || {
+                let spacing = s.pattern.clamp(2, 16).next_power_of_two() as usize;
+                let disc = screen_space::discontinuities(
+                    view.width() as usize,
+                    view.height() as usize,
+                    &view.valid_mask(),
+                    view.depths(),
+                    view.geometric_normals(),
+                    2 * spacing,
+                );
+                (s, screen_space::pattern(s.pattern), disc, eta)
+            })),
+            _ => None,
+        };
         let w = view.width() as usize;
         struct Row {
-            v: Vec<f32>,
+            v: Vec<Vec3>,
+            weight: Vec<f32>,
             class: Vec<PixelClass>,
+            counts: Counts,
             outside: u64,
             facing_away: u64,
+            lit: u64,
+            umbra: u64,
+            reconstructed: u64,
         }
+        let context =
+            sm.as_ref()
+                .zip(pyramid.as_ref().zip(domain.as_ref()))
+                .map(|(m, (pyr, dom))| {
+                    let (left, _, _, top, _, _) = m.view.extents();
+                    Context {
+                        sm: m,
+                        pyramid: pyr,
+                        domain: dom,
+                        frame: &p.frame,
+                        map_frame: MapFrame {
+                            left: left as f64,
+                            top: top as f64,
+                            texels_per_unit: m.texels_per_unit,
+                        },
+                        selection,
+                    }
+                });
+        let eye = view.eye();
         let rows: Vec<Row> = stats.time("filter", || {
             (0..view.height() as usize)
                 .into_par_iter()
-                .map(|row| {
+                .map_init(Scratch::default, |scratch, row| {
                     let mut r = Row {
-                        v: vec![0.0; w],
+                        v: vec![Vec3::ZERO; w],
+                        weight: vec![1.0; w],
                         class: vec![PixelClass::Background; w],
+                        counts: Counts::default(),
                         outside: 0,
                         facing_away: 0,
+                        lit: 0,
+                        umbra: 0,
+                        reconstructed: 0,
                     };
                     for x in 0..w {
                         let i = row * w + x;
@@ -310,24 +508,64 @@ impl ShadowTechnique for ShadowMapFilter {
                             r.class[x] = PixelClass::Skipped;
                             continue;
                         }
-                        let projected = sm
+                        let projected = context
                             .as_ref()
-                            .zip(pyramid.as_ref().zip(outline.as_ref()))
-                            .and_then(|(m, h)| m.project(origins[i]).map(|q| (m, h, q)));
-                        let lit = match projected {
+                            .and_then(|cx| cx.sm.project(origins[i]).map(|q| (cx, q)));
+                        let outcome = match projected {
                             None => {
                                 r.outside += 1;
-                                1.0
+                                Outcome::Lit
                             }
-                            Some((m, h, (tx, ty, z))) => {
-                                let plane = m.receiver_plane(origins[i], s.geometric_normal);
-                                let texel = z / m.texels_per_unit as f32;
-                                let bias = texel + 1e-6 * p.extent;
-                                self.lit(m, h.0, h.1, &p.frame, tx, ty, z, bias, &plane)
+                            Some((cx, (tx, ty, z))) => {
+                                let texel = z / cx.sm.texels_per_unit as f32;
+                                let receiver = Receiver {
+                                    x: tx,
+                                    y: ty,
+                                    z,
+                                    plane: cx.sm.inverse_plane(origins[i], s.geometric_normal),
+                                    bias: texel + 1e-6 * p.extent,
+                                };
+                                let to_eye = match eye {
+                                    Some(e) => (e - s.position).normalize_or_zero(),
+                                    None => {
+                                        camera.view_from_world.inverse().transform_vector3(Vec3::Z)
+                                    }
+                                };
+                                let z_pe = if perspective { s.depth } else { 1.0 };
+                                self.shade(
+                                    cx,
+                                    &receiver,
+                                    (x as u32, row as u32, i),
+                                    (z_pe, s.geometric_normal.dot(to_eye)),
+                                    scratch,
+                                    &mut r.counts,
+                                )
                             }
                         };
-                        let v = (lit * h).clamp(0.0, 1.0);
-                        r.v[x] = v;
+                        let (frac, rgb) = match outcome {
+                            Outcome::Lit => {
+                                r.lit += 1;
+                                (1.0, mean_radiance)
+                            }
+                            Outcome::Umbra => {
+                                r.umbra += 1;
+                                (0.0, Vec3::ZERO)
+                            }
+                            Outcome::Integrated(c) => (c.area as f32, c.radiance.as_vec3()),
+                            Outcome::Fraction(f) => (f as f32, mean_radiance * f as f32),
+                            Outcome::Reconstruct => {
+                                r.reconstructed += 1;
+                                r.weight[x] = 0.0;
+                                r.class[x] = PixelClass::Skipped;
+                                continue;
+                            }
+                        };
+                        let v = (frac * h).clamp(0.0, 1.0);
+                        r.v[x] = if textured {
+                            (rgb * h).max(Vec3::ZERO)
+                        } else {
+                            Vec3::splat(v)
+                        };
                         r.class[x] = if v >= 1.0 {
                             PixelClass::Lit
                         } else if v <= 0.0 {
@@ -340,23 +578,72 @@ impl ShadowTechnique for ShadowMapFilter {
                 })
                 .collect()
         });
-        let mut vis = VisibilityImage::scalar(view);
+        let mut values = Vec::with_capacity(n);
+        let mut weights = Vec::with_capacity(n);
         let mut classes = Vec::with_capacity(n);
-        let (mut outside, mut facing_away) = (0, 0);
-        for (row, r) in rows.into_iter().enumerate() {
-            vis.scalars_mut()[row * w..(row + 1) * w].copy_from_slice(&r.v);
+        let mut counts = Counts::default();
+        let (mut outside, mut facing_away, mut lit, mut umbra, mut reconstructed) = (0, 0, 0, 0, 0);
+        for r in rows {
+            values.extend(r.v);
+            weights.extend(r.weight);
             classes.extend(r.class);
+            counts.edges += r.counts.edges;
+            counts.levels += r.counts.levels;
+            counts.blended += r.counts.blended;
+            counts.read += r.counts.read;
             outside += r.outside;
             facing_away += r.facing_away;
+            lit += r.lit;
+            umbra += r.umbra;
+            reconstructed += r.reconstructed;
+        }
+        if reconstructed > 0 {
+            stats.time("pull-push", || {
+                let mut flat: Vec<f32> = values.iter().flat_map(|v| v.to_array()).collect();
+                // Background pixels carry no value: they must not feed the reconstruction.
+                let wts: Vec<f32> = (0..n)
+                    .map(|i| if view.is_valid(i) { weights[i] } else { 0.0 })
+                    .collect();
+                screen_space::pull_push(w, view.height() as usize, 3, &mut flat, &wts);
+                for (i, v) in values.iter_mut().enumerate() {
+                    if view.is_valid(i) {
+                        *v = Vec3::from_slice(&flat[3 * i..3 * i + 3]).max(Vec3::ZERO);
+                    }
+                }
+            });
+        }
+        let mut vis = if textured {
+            let mut vis = VisibilityImage::rgb_buffer(view);
+            vis.rgbs_mut().copy_from_slice(&values);
+            vis
+        } else {
+            let mut vis = VisibilityImage::scalar(view);
+            for (d, v) in vis.scalars_mut().iter_mut().zip(&values) {
+                *d = v.x.clamp(0.0, 1.0);
+            }
+            vis
+        };
+        if let Coefficients::Scalar(_) = vis.coefficients() {
+            // Already clamped.
         }
         vis.set_classes(classes)?;
-        let counts = vis.class_counts().unwrap_or_default();
+        let counts_by_class = vis.class_counts().unwrap_or_default();
         stats.add("pixels-facing-away", facing_away);
         stats.add("pixels-outside-frustum", outside);
-        stats.add("pixels-lit", counts[PixelClass::Lit as usize]);
-        stats.add("pixels-umbra", counts[PixelClass::Umbra as usize]);
-        stats.add("pixels-penumbra", counts[PixelClass::Penumbra as usize]);
+        stats.add("pixels-skipped-lit", lit);
+        stats.add("pixels-skipped-umbra", umbra);
+        stats.add("pixels-reconstructed", reconstructed);
+        stats.add("pixels-lit", counts_by_class[PixelClass::Lit as usize]);
+        stats.add("pixels-umbra", counts_by_class[PixelClass::Umbra as usize]);
+        stats.add(
+            "pixels-penumbra",
+            counts_by_class[PixelClass::Penumbra as usize],
+        );
         stats.add("shadow-map-texels", (self.resolution as u64).pow(2));
+        stats.add("contour-edges", counts.edges);
+        stats.add("contour-levels", counts.levels);
+        stats.add("pixels-blended", counts.blended);
+        stats.add("samples-read", counts.read);
         vis.validate()?;
         Ok(Estimate {
             visibility: vis,

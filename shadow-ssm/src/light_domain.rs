@@ -1,0 +1,466 @@
+//! The light as the visibility integrals of soft shadow mapping see it: its outline in the
+//! shadow map's view plane (the light's centre at the origin, depth 0), the clipping of regions
+//! to it, and the integral of the light's radiance over a region.
+//!
+//! * Back-projection (GBP06, BCS06 eq. 1) integrates axis-aligned rectangles clipped to the
+//!   light ([`LightDomain::rect`]).
+//! * Contours (GBP07 section 4.2) integrate radially from the light's centre: each oriented
+//!   contour edge adds or removes the part of the light inside the wedge its end points span
+//!   from the centre and beyond the edge ([`LightDomain::edge`], Fig. 5a, as penumbra wedges
+//!   do, [ADMAM03]). The region is the light clipped by three half-planes, so any simple
+//!   polygon light works, convex or not.
+//! * Textured rectangle lights (GBP07 section 8: edge integration fits textured planar lights)
+//!   weight each region by the radiance over it: Green's theorem turns the area integral into
+//!   the boundary integral of `F(u, v) = ∫_0^u L(s, v) ds`, tabulated on the light's uv square
+//!   and integrated with Gauss-Legendre quadrature along the region's edges
+//!   ([`RadianceTable`]). The visibility of a textured light is then
+//!   `(1/A) ∫ L(x) vis(x) dx`, DCS eq. 2's limit for many samples.
+
+use glam::{DAffine2, DVec2, DVec3, Vec2};
+use shadow_core::light::{AreaLight, LightGeometry};
+
+/// Cells per side of a radiance table.
+const TABLE_CELLS: usize = 64;
+
+/// Area and radiance integrated over a region of the light.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Covered {
+    /// Area (view-plane units).
+    pub area: f64,
+    /// Integral of the radiance over the area (zero unless the light is textured).
+    pub radiance: DVec3,
+}
+
+impl std::ops::AddAssign for Covered {
+    fn add_assign(&mut self, o: Self) {
+        self.area += o.area;
+        self.radiance += o.radiance;
+    }
+}
+
+impl std::ops::SubAssign for Covered {
+    fn sub_assign(&mut self, o: Self) {
+        self.area -= o.area;
+        self.radiance -= o.radiance;
+    }
+}
+
+/// The light's outline in the shadow map's view plane and, for a textured light, its radiance.
+#[derive(Debug, Clone)]
+pub struct LightDomain {
+    points: Vec<DVec2>,
+    area: f64,
+    texture: Option<RadianceTable>,
+    full: Covered,
+}
+
+impl LightDomain {
+    /// From outline points in view space (x, y; the light's centre at the origin).
+    pub fn new(points: &[Vec2]) -> Self {
+        let points: Vec<DVec2> = points.iter().map(|p| p.as_dvec2()).collect();
+        let area = polygon_area(&points).abs();
+        Self {
+            full: Covered {
+                area,
+                radiance: DVec3::ZERO,
+            },
+            points,
+            area,
+            texture: None,
+        }
+    }
+
+    /// Adds the radiance of a textured light; `uv_from_view` maps view-plane points to the
+    /// light's uv.
+    #[must_use]
+    pub fn with_texture(mut self, table: RadianceTable) -> Self {
+        self.full.radiance = table.integrate(&self.points);
+        self.texture = Some(table);
+        self
+    }
+
+    /// Area of the light.
+    pub fn area(&self) -> f64 {
+        self.area
+    }
+
+    /// The whole light: its area and radiance integral.
+    pub fn full(&self) -> Covered {
+        self.full
+    }
+
+    /// True when the radiance is integrated too.
+    pub fn is_textured(&self) -> bool {
+        self.texture.is_some()
+    }
+
+    fn covered(&self, poly: &[DVec2]) -> Covered {
+        if poly.len() < 3 {
+            return Covered::default();
+        }
+        Covered {
+            area: polygon_area(poly).abs(),
+            radiance: self
+                .texture
+                .as_ref()
+                .map_or(DVec3::ZERO, |t| t.integrate(poly)),
+        }
+    }
+
+    /// The light clipped to the axis-aligned rectangle `lo..hi` (empty when they miss).
+    fn clip_rect(&self, lo: DVec2, hi: DVec2) -> Vec<DVec2> {
+        if !(lo.x < hi.x && lo.y < hi.y) {
+            return Vec::new();
+        }
+        let mut poly = self.points.clone();
+        let mut scratch = Vec::with_capacity(poly.len() + 4);
+        for (n, c) in [
+            (DVec2::X, lo.x),
+            (DVec2::NEG_X, -hi.x),
+            (DVec2::Y, lo.y),
+            (DVec2::NEG_Y, -hi.y),
+        ] {
+            clip(&mut poly, &mut scratch, n, c);
+            if poly.len() < 3 {
+                return Vec::new();
+            }
+        }
+        poly
+    }
+
+    /// The light inside the axis-aligned rectangle `lo..hi`.
+    pub fn rect(&self, lo: DVec2, hi: DVec2) -> Covered {
+        self.covered(&self.clip_rect(lo, hi))
+    }
+
+    /// Area of the light inside the axis-aligned rectangle `lo..hi`.
+    pub fn clipped_area(&self, lo: DVec2, hi: DVec2) -> f64 {
+        let poly = self.clip_rect(lo, hi);
+        if poly.len() < 3 {
+            0.0
+        } else {
+            polygon_area(&poly).abs()
+        }
+    }
+
+    /// The signed contribution of the oriented contour edge `a -> b` (view-plane points) to the
+    /// occluded part of the light, for an occluder lying on the edge's right (`(b - a) x (o - a)
+    /// < 0` for occluded points `o`): the light inside the wedge spanned by `a` and `b` from the
+    /// centre and beyond the edge, counted positively when the edge turns counter-clockwise
+    /// around the centre (the ray from the centre enters the occluder there) and negatively
+    /// otherwise (GBP07 section 4.2, Fig. 5a). With the centre's own state as the start, the
+    /// sum over a contour is the occluded part of the light.
+    pub fn edge(
+        &self,
+        a: DVec2,
+        b: DVec2,
+        poly: &mut Vec<DVec2>,
+        scratch: &mut Vec<DVec2>,
+    ) -> Covered {
+        let turn = a.perp_dot(b);
+        if turn == 0.0 || !turn.is_finite() {
+            return Covered::default();
+        }
+        let (a, b, sign) = if turn > 0.0 {
+            (a, b, 1.0)
+        } else {
+            (b, a, -1.0)
+        };
+        // Now a -> b turns counter-clockwise: the wedge is {x: a x x >= 0, x x b >= 0}; beyond
+        // the edge is the side of line ab away from the origin.
+        poly.clear();
+        poly.extend_from_slice(&self.points);
+        let beyond = DVec2::new(b.y - a.y, a.x - b.x); // right normal of a -> b
+        for (n, c) in [(a.perp(), 0.0), (-b.perp(), 0.0), (beyond, beyond.dot(a))] {
+            clip(poly, scratch, n, c);
+            if poly.len() < 3 {
+                return Covered::default();
+            }
+        }
+        let mut c = self.covered(poly);
+        c.area *= sign;
+        c.radiance *= sign;
+        c
+    }
+}
+
+/// Clips `poly` to the half-plane `n . x >= c` (Sutherland-Hodgman; a concave subject gives
+/// extra zero-area edges, never a wrong area).
+fn clip(poly: &mut Vec<DVec2>, scratch: &mut Vec<DVec2>, n: DVec2, c: f64) {
+    scratch.clear();
+    let m = poly.len();
+    for i in 0..m {
+        let (a, b) = (poly[i], poly[(i + 1) % m]);
+        let (sa, sb) = (n.dot(a) - c, n.dot(b) - c);
+        if sa >= 0.0 {
+            scratch.push(a);
+        }
+        if (sa >= 0.0) != (sb >= 0.0) {
+            scratch.push(a + (b - a) * (sa / (sa - sb)));
+        }
+    }
+    std::mem::swap(poly, scratch);
+}
+
+/// Signed area of a polygon (positive counter-clockwise).
+pub fn polygon_area(p: &[DVec2]) -> f64 {
+    let n = p.len();
+    let mut s = 0.0;
+    for i in 0..n {
+        s += p[i].perp_dot(p[(i + 1) % n]);
+    }
+    0.5 * s
+}
+
+/// The radiance of a textured rectangle light, ready for integration over polygons of its
+/// plane: `F(u, v) = ∫_0^u L(s, v) ds` on a grid of the uv square, bilinearly interpolated.
+#[derive(Debug, Clone)]
+pub struct RadianceTable {
+    /// `F` at `(i / n, j / n)`, `j` major, `n + 1` a side.
+    f: Vec<DVec3>,
+    uv_from_view: DAffine2,
+    /// View-plane area of one unit of uv area.
+    jacobian: f64,
+}
+
+impl RadianceTable {
+    /// The table of a textured rectangle light seen in a view whose x and y axes are
+    /// `view_x`, `view_y` (world directions); `None` for other lights or constant radiance.
+    pub fn new(light: &dyn AreaLight, view_x: glam::Vec3, view_y: glam::Vec3) -> Option<Self> {
+        if !light.is_textured() {
+            return None;
+        }
+        let LightGeometry::Rectangle { half_u, half_v, .. } = light.geometry() else {
+            return None;
+        };
+        let (hu, hv) = (half_u.as_dvec3(), half_v.as_dvec3());
+        let (x, y) = (view_x.as_dvec3(), view_y.as_dvec3());
+        // uv = 0.5 + 0.5 (d . hu / |hu|^2, d . hv / |hv|^2), d = x_view X + y_view Y.
+        let (su, sv) = (0.5 / hu.length_squared(), 0.5 / hv.length_squared());
+        let uv_from_view = DAffine2::from_cols(
+            DVec2::new(x.dot(hu) * su, x.dot(hv) * sv),
+            DVec2::new(y.dot(hu) * su, y.dot(hv) * sv),
+            DVec2::splat(0.5),
+        );
+        let det = uv_from_view.matrix2.determinant().abs();
+        if !(det > 0.0) {
+            return None;
+        }
+        let n = TABLE_CELLS;
+        // Each cell of a row integrated with 8 midpoint samples.
+        const SUB: usize = 8;
+        let radiance = light.radiance();
+        let mut f = vec![DVec3::ZERO; (n + 1) * (n + 1)];
+        for j in 0..=n {
+            let v = j as f32 / n as f32;
+            let mut acc = DVec3::ZERO;
+            for i in 0..n {
+                let mut cell = DVec3::ZERO;
+                for k in 0..SUB {
+                    let u = (i as f32 + (k as f32 + 0.5) / SUB as f32) / n as f32;
+                    cell += radiance.at(Vec2::new(u, v)).as_dvec3();
+                }
+                acc += cell / (SUB * n) as f64;
+                f[j * (n + 1) + i + 1] = acc;
+            }
+        }
+        Some(Self {
+            f,
+            uv_from_view,
+            jacobian: 1.0 / det,
+        })
+    }
+
+    fn f_at(&self, uv: DVec2) -> DVec3 {
+        let n = TABLE_CELLS;
+        let (x, y) = (
+            (uv.x.clamp(0.0, 1.0) * n as f64).min(n as f64 - 1e-9),
+            (uv.y.clamp(0.0, 1.0) * n as f64).min(n as f64 - 1e-9),
+        );
+        let (i, j) = (x.floor() as usize, y.floor() as usize);
+        let (fx, fy) = (x - i as f64, y - j as f64);
+        let at = |i: usize, j: usize| self.f[j * (n + 1) + i];
+        let top = at(i, j) * (1.0 - fx) + at(i + 1, j) * fx;
+        let bottom = at(i, j + 1) * (1.0 - fx) + at(i + 1, j + 1) * fx;
+        top * (1.0 - fy) + bottom * fy
+    }
+
+    /// The radiance integrated over a polygon of the view plane (its orientation does not
+    /// matter): `∮ F dv` by 2-point Gauss-Legendre on pieces of at most one table cell.
+    pub fn integrate(&self, poly: &[DVec2]) -> DVec3 {
+        let g = 0.5 / 3f64.sqrt();
+        let mut sum = DVec3::ZERO;
+        let m = poly.len();
+        for k in 0..m {
+            let (a, b) = (
+                self.uv_from_view.transform_point2(poly[k]),
+                self.uv_from_view.transform_point2(poly[(k + 1) % m]),
+            );
+            let dv = b.y - a.y;
+            if dv == 0.0 {
+                continue;
+            }
+            let pieces =
+                (((b - a).abs().max_element() * TABLE_CELLS as f64).ceil() as usize).max(1);
+            let step = 1.0 / pieces as f64;
+            let mut s = DVec3::ZERO;
+            for p in 0..pieces {
+                let t0 = p as f64 * step;
+                for t in [t0 + step * (0.5 - g), t0 + step * (0.5 + g)] {
+                    s += self.f_at(a + (b - a) * t);
+                }
+            }
+            sum += s * (0.5 * step * dv);
+        }
+        (sum * self.jacobian).abs()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+    use shadow_core::light::{Radiance, RectLight, TexturedRadiance};
+
+    fn square() -> LightDomain {
+        LightDomain::new(&[
+            Vec2::new(-0.5, -0.5),
+            Vec2::new(0.5, -0.5),
+            Vec2::new(0.5, 0.5),
+            Vec2::new(-0.5, 0.5),
+        ])
+    }
+
+    #[test]
+    fn clipped_rectangles_of_a_square_light() {
+        let l = square();
+        assert!((l.area() - 1.0).abs() < 1e-12);
+        let a = l.clipped_area(DVec2::new(0.0, 0.0), DVec2::new(2.0, 2.0));
+        assert!((a - 0.25).abs() < 1e-12);
+        let a = l.rect(DVec2::new(-0.1, -0.2), DVec2::new(0.1, 0.2)).area;
+        assert!((a - 0.08).abs() < 1e-12);
+        assert_eq!(
+            l.clipped_area(DVec2::new(1.0, 1.0), DVec2::new(2.0, 2.0)),
+            0.0
+        );
+    }
+
+    /// GBP07 section 4.2: the radial integral of one edge is the light clipped to the wedge
+    /// and beyond the edge, here checked against the clipped polygon worked by hand.
+    #[test]
+    fn radial_integral_of_one_edge_is_the_clipped_polygon_area() {
+        let l = square();
+        let (mut p, mut s) = (Vec::new(), Vec::new());
+        // A horizontal edge at y = 0.25 from x = 0.25 to x = -0.25 (counter-clockwise around
+        // the centre): the wedge beyond it is the trapezoid between y = 0.25 and y = 0.5 under
+        // the rays through the end points, widths 0.5 and 1.0: area 0.25 * 0.75 = 0.1875.
+        let c = l.edge(
+            DVec2::new(0.25, 0.25),
+            DVec2::new(-0.25, 0.25),
+            &mut p,
+            &mut s,
+        );
+        assert!((c.area - 0.1875).abs() < 1e-12, "{c:?}");
+        // Reversed, the sign flips.
+        let c = l.edge(
+            DVec2::new(-0.25, 0.25),
+            DVec2::new(0.25, 0.25),
+            &mut p,
+            &mut s,
+        );
+        assert!((c.area + 0.1875).abs() < 1e-12, "{c:?}");
+        // An edge reaching past the light: its wedge spans nearly the upper half-plane, so it
+        // covers the whole part of the light above it, 1 x 0.4.
+        let c = l.edge(DVec2::new(2.0, 0.1), DVec2::new(-2.0, 0.1), &mut p, &mut s);
+        assert!((c.area - 0.4).abs() < 1e-12, "{c:?}");
+        // A short edge at the same height: the wedge from (0.2, 0.1) to (-0.1, 0.1) reaches
+        // y = 0.5 at x = 1.0 and -0.5, clipped at x = 0.5: the trapezoid of widths 0.3 and 1.5
+        // over 0.4 (0.36) minus the triangle beyond x = 0.5 (from y = 0.25, legs 0.25 and 0.5:
+        // 0.0625).
+        let c = l.edge(DVec2::new(0.2, 0.1), DVec2::new(-0.1, 0.1), &mut p, &mut s);
+        assert!((c.area - 0.2975).abs() < 1e-12, "{c:?}");
+        // An edge entirely outside the light adds nothing.
+        let c = l.edge(DVec2::new(1.0, 1.0), DVec2::new(-1.0, 1.0), &mut p, &mut s);
+        assert_eq!(c.area, 0.0);
+    }
+
+    /// A closed square contour (occluder on the right of each edge, i.e. clockwise) sums, with
+    /// the centre's state as the start, to the occluded area, wherever it lies.
+    #[test]
+    fn a_closed_contour_integrates_to_its_clipped_area() {
+        let l = square();
+        let (mut p, mut s) = (Vec::new(), Vec::new());
+        for (lo, hi, centre_inside) in [
+            (DVec2::new(-0.2, -0.1), DVec2::new(0.3, 0.2), true),
+            (DVec2::new(0.1, 0.1), DVec2::new(0.9, 0.3), false),
+            (DVec2::new(-2.0, -0.3), DVec2::new(-0.25, 2.0), false),
+            (DVec2::new(-2.0, -2.0), DVec2::new(2.0, 2.0), true),
+        ] {
+            // Clockwise: occluder on the right.
+            let pts = [lo, DVec2::new(lo.x, hi.y), hi, DVec2::new(hi.x, lo.y)];
+            let mut occluded = if centre_inside { l.area() } else { 0.0 };
+            for k in 0..4 {
+                occluded += l.edge(pts[k], pts[(k + 1) % 4], &mut p, &mut s).area;
+            }
+            let want = l.clipped_area(lo, hi);
+            assert!(
+                (occluded - want).abs() < 1e-12,
+                "{lo} {hi}: {occluded} vs {want}"
+            );
+        }
+    }
+
+    #[test]
+    fn radiance_integral_matches_a_fine_sum() {
+        let mut texels = Vec::new();
+        for y in 0..4 {
+            for x in 0..4 {
+                texels.push(Vec3::new(x as f32, y as f32, 1.0 + (x * y) as f32));
+            }
+        }
+        let tex = TexturedRadiance::new(4, 4, texels, Vec3::ONE, glam::Affine2::IDENTITY).unwrap();
+        let light = RectLight::facing(
+            Vec3::new(0.0, 2.0, 0.0),
+            Vec3::NEG_Y,
+            2.0,
+            1.0,
+            Radiance::Textured(tex),
+        )
+        .unwrap();
+        let LightGeometry::Rectangle { half_u, half_v, .. } = light.geometry() else {
+            unreachable!()
+        };
+        // A view whose axes are the light's own, rotated by 30 degrees.
+        let (a, b) = (half_u.normalize(), half_v.normalize());
+        let (c, s) = (30f32.to_radians().cos(), 30f32.to_radians().sin());
+        let (vx, vy) = (a * c + b * s, b * c - a * s);
+        let table = RadianceTable::new(&light, vx, vy).unwrap();
+        let tri = [
+            DVec2::new(-0.6, -0.3),
+            DVec2::new(0.7, -0.2),
+            DVec2::new(0.1, 0.4),
+        ];
+        let got = table.integrate(&tri);
+        // Brute force: midpoint sum on a fine grid of the triangle's bounds.
+        let n = 600;
+        let mut want = DVec3::ZERO;
+        let (lo, hi) = (DVec2::new(-0.6, -0.3), DVec2::new(0.7, 0.4));
+        let cell = (hi - lo) / n as f64;
+        let inside =
+            |p: DVec2| (0..3).all(|k| (tri[(k + 1) % 3] - tri[k]).perp_dot(p - tri[k]) >= 0.0);
+        for j in 0..n {
+            for i in 0..n {
+                let p = lo + cell * DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
+                if inside(p) {
+                    let w = light.center().as_dvec3() + vx.as_dvec3() * p.x + vy.as_dvec3() * p.y;
+                    let uv = light.uv_of(w.as_vec3());
+                    want += light.radiance().at(uv).as_dvec3() * cell.x * cell.y;
+                }
+            }
+        }
+        assert!(
+            (got - want).abs().max_element() < 2e-3 * want.max_element(),
+            "{got} vs {want}"
+        );
+    }
+}
