@@ -224,7 +224,7 @@ pub struct Receiver {
 /// Reusable buffers of one worker.
 #[derive(Debug, Default)]
 pub struct Scratch {
-    states: Vec<bool>,
+    states: Vec<u64>,
     poly: Vec<DVec2>,
     clip: Vec<DVec2>,
 }
@@ -242,26 +242,55 @@ pub fn occluded(
 ) -> (Covered, u64) {
     let s = level.scale;
     let half_block = 0.5 * (s - 1.0);
-    let occ = |i: i64, j: i64| -> bool {
-        let d = level.at(i, j);
-        d < r
-            .plane
-            .depth((i as f64 + 0.5) * s, (j as f64 + 0.5) * s, half_block)
-            - r.bias
-    };
     let (xl, yl) = (r.x / s, r.y / s);
     let h = 0.5 * width / s;
     let (i0, i1) = ((xl - h).floor() as i64 - 1, (xl + h).floor() as i64 + 1);
     let (j0, j1) = ((yl - h).floor() as i64 - 1, (yl + h).floor() as i64 + 1);
     let nx = (i1 - i0 + 1) as usize;
+    // A sample occludes when it lies in front of the receiver's plane (its nearest point over
+    // the sample's block) by more than the bias: with the plane's inverse depth `inv`,
+    // `d < 1 / inv - bias`, i.e. `(d + bias) inv < 1`, or any finite depth where the plane is
+    // behind the light (`inv <= 0`). The inverse depth is linear in the texel coordinates, so
+    // a row is tested branch-free in f32 lanes.
+    let plane = &r.plane;
+    let slack = (plane.b.abs() + plane.c.abs()) * half_block;
+    let bias = r.bias;
+    // One bit per sample, rows of `words` u64s.
+    let words = nx.div_ceil(64);
     let states = &mut scratch.states;
     states.clear();
-    for j in j0..=j1 {
-        for i in i0..=i1 {
-            states.push(occ(i, j));
+    states.resize(words * (j1 - j0 + 1) as usize, 0);
+    let side = level.side as i64;
+    let (lo, hi) = ((-i0).max(0) as usize, (side - 1 - i0).min(nx as i64 - 1));
+    for j in j0.max(0)..=j1.min(side - 1) {
+        if hi < lo as i64 {
+            break;
+        }
+        let base = (j - j0) as usize * words;
+        let inv0 =
+            plane.a + plane.b * (i0 as f64 + 0.5) * s + plane.c * (j as f64 + 0.5) * s + slack;
+        let step = (plane.b * s) as f32;
+        // Sample k of the row (k >= lo, so i0 + k >= 0) is row[k - lo].
+        let row = &level.depth[(j * side + i0 + lo as i64) as usize..];
+        // Branch-free in f32 lanes, one word at a time.
+        let (inv0, hi) = (inv0 as f32, hi as usize);
+        for w in lo / 64..=hi / 64 {
+            let (k0, k1) = ((64 * w).max(lo), (64 * w + 63).min(hi));
+            let mut bits = 0u64;
+            for k in k0..=k1 {
+                let d = row[k - lo];
+                let inv = inv0 + step * k as f32;
+                let o = d.is_finite() & ((inv <= 0.0) | ((d + bias) * inv < 1.0));
+                bits |= (o as u64) << (k - 64 * w);
+            }
+            states[base + w] = bits;
         }
     }
-    let state = |i: i64, j: i64| states[(j - j0) as usize * nx + (i - i0) as usize];
+    let states = &scratch.states;
+    let state = |i: i64, j: i64| {
+        let k = (i - i0) as usize;
+        states[(j - j0) as usize * words + k / 64] >> (k % 64) & 1 == 1
+    };
     let mask_at = |bi: i64, bj: i64| -> u8 {
         state(bi, bj) as u8
             | (state(bi + 1, bj) as u8) << 1
@@ -295,16 +324,31 @@ pub fn occluded(
         Covered::default()
     };
     let mut edges = 0u64;
+    let blocks = nx - 1;
     for bj in j0..j1 {
-        for bi in i0..i1 {
-            let m = mask_at(bi, bj);
-            if m == 0 || m == 0xF {
-                continue;
+        let (top, bottom) = (
+            &states[(bj - j0) as usize * words..][..words],
+            &states[(bj - j0 + 1) as usize * words..][..words],
+        );
+        for w in 0..words {
+            // Bit k: sample k of the row; shifted: sample k + 1. A block is mixed unless its
+            // four samples agree.
+            let next = |row: &[u64]| row[w] >> 1 | row.get(w + 1).map_or(0, |n| n << 63);
+            let (a, a1, b, b1) = (top[w], next(top), bottom[w], next(bottom));
+            let mut mixed = (a | a1 | b | b1) & !(a & a1 & b & b1);
+            let valid = blocks.saturating_sub(64 * w).min(64);
+            if valid < 64 {
+                mixed &= (1u64 << valid) - 1;
             }
-            for (a, b) in block_edges(m, t) {
-                let (pa, pb) = (back_project(bi, bj, &a), back_project(bi, bj, &b));
-                sum += light.edge(pa, pb, &mut scratch.poly, &mut scratch.clip);
-                edges += 1;
+            while mixed != 0 {
+                let k = mixed.trailing_zeros() as i64;
+                mixed &= mixed - 1;
+                let bi = i0 + 64 * w as i64 + k;
+                for (a, b) in block_edges(mask_at(bi, bj), t) {
+                    let (pa, pb) = (back_project(bi, bj, &a), back_project(bi, bj, &b));
+                    sum += light.edge(pa, pb, &mut scratch.poly, &mut scratch.clip);
+                    edges += 1;
+                }
             }
         }
     }
