@@ -1,11 +1,19 @@
 //! # shadow-ssm
 //!
-//! Shadow-map soft shadows. This first part of the soft shadow mapping family holds the
-//! light-centre shadow map of GBP07 section 3 ([`shadow_map`]), its hierarchical min/max version
-//! with GBP07's converging kernel ([`hierarchy`]), and the single-sample baselines a
-//! renderer would otherwise pick, PCF and PCSS ([`technique`]); back-projection (GBP06),
-//! depth peeling (BCS06), contours and the adaptive scheme (GBP07 sections 4 and 5) build on the
-//! same map.
+//! Soft shadow mapping: every filter reads one light-centre shadow map (GBP07 section 3,
+//! [`shadow_map`]) and its min/max pyramid with GBP07's converging kernel ([`hierarchy`]).
+//!
+//! * Baselines a renderer would otherwise pick: PCF and PCSS ([`technique`]).
+//! * Back-projection with gap filling (GBP06 as BCS06 section 2 summarises it) and depth peeling
+//!   with midpoint layers (BCS06 section 4): [`backprojection`].
+//! * Contours integrated radially (GBP07 section 4): [`contours`], [`light_domain`].
+//! * The adaptive scheme (GBP07 section 5): light-space multi-resolution ([`light_space`]) and
+//!   screen-space selection with pull-push ([`screen_space`]).
+//! * Rectangle, disk and polygon lights; textured rectangle lights for the filters that
+//!   integrate over the light (radiance integrated over the uncovered area).
+//!
+//! Presets: `pcf`, `pcss`, `ssm-backprojection`, `ssm-peeling`, `ssm-contours`,
+//! `ssm-adaptive`.
 //!
 //! ```
 //! use shadow_core::prelude::*;

@@ -7,7 +7,7 @@
 //! * Contours (GBP07 section 4.2) integrate radially from the light's centre: each oriented
 //!   contour edge adds or removes the part of the light inside the wedge its end points span
 //!   from the centre and beyond the edge ([`LightDomain::edge`], Fig. 5a, as penumbra wedges
-//!   do, [ADMAM03]). The region is the light clipped by three half-planes, so any simple
+//!   do, ADMAM03). The region is the light clipped by three half-planes, so any simple
 //!   polygon light works, convex or not.
 //! * Textured rectangle lights (GBP07 section 8: edge integration fits textured planar lights)
 //!   weight each region by the radiance over it: Green's theorem turns the area integral into
