@@ -4,9 +4,9 @@
 //! the occluded fraction is the sum of the clipped areas over the light's area.
 //!
 //! * Kernel: GBP07's converged kernel from the min/max pyramid; a receiver with nothing in
-//!   front of it there is lit without back-projection. Umbra cannot be concluded from depth
-//!   bounds alone (occluding samples may leave gaps), so every other receiver is integrated
-//!   and classified from the result.
+//!   front of it there is lit without back-projection; one whose kernel (with a texel's
+//!   border) lies wholly in front is umbra (GBP06: the gap-filled samples then cover the
+//!   light). Every other receiver is integrated and classified from the result.
 //! * Gap filling (GBP06): each occluding sample's rectangle is extended to meet the rectangles
 //!   of its right and upper occluding neighbours, closing the gaps between adjacent samples
 //!   seen from the receiver (and adding overlap: the over-estimation GBP07 section 4 removes).

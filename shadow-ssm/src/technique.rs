@@ -18,8 +18,9 @@
 //! (at or behind the light's plane) take the horizon fraction alone and are counted.
 //!
 //! Every receiver is first classified from the min/max pyramid over its converged kernel:
-//! nothing in front of it means lit (`pixels-skipped-lit`); for contours, every sample in front
-//! means umbra (`pixels-skipped-umbra`, the contours then have no edge and hide the centre).
+//! nothing in front of it means lit (`pixels-skipped-lit`); for back-projection and contours,
+//! every sample in front means umbra (`pixels-skipped-umbra`, GBP06: the back-projections then
+//! cover the light, the contours have no edge and hide the centre).
 //! Only the rest is integrated; with screen-space selection some of those are left to pull-push
 //! (`pixels-reconstructed`).
 
@@ -256,6 +257,9 @@ impl ShadowMapFilter {
                     return Outcome::Lit;
                 }
                 let kernel = kernel.clamp(1.0, MAX_KERNEL);
+                if umbra(sm, pyramid, r, kernel) {
+                    return Outcome::Umbra;
+                }
                 let (occluded, read) = bp.occluded(sm, cx.domain, x, y, z, kernel, &occludes);
                 counts.read += read;
                 Outcome::Integrated(unoccluded(cx.domain, occluded))
@@ -266,20 +270,7 @@ impl ShadowMapFilter {
                     return Outcome::Lit;
                 }
                 let kernel = kernel.max(1.0);
-                // Umbra: every sample of the kernel in front of the receiver's plane.
-                let h = 0.5 * kernel;
-                let (x0, y0, x1, y1) = (
-                    (x - h).floor() as i64 - 1,
-                    (y - h).floor() as i64 - 1,
-                    (x + h).floor() as i64 + 1,
-                    (y + h).floor() as i64 + 1,
-                );
-                let inside_map =
-                    x0 >= 0 && y0 >= 0 && x1 < sm.view.width as i64 && y1 < sm.view.height as i64;
-                if inside_map
-                    && let Some((_, max)) = pyramid.bounds(x0, y0, x1, y1)
-                    && max < r.plane.depth(x, y, h + 1.5) - bias
-                {
+                if umbra(sm, pyramid, r, kernel) {
                     return Outcome::Umbra;
                 }
                 let z_occ = light_space::occluder_depth(pyramid, kernel, x, y, z);
@@ -308,6 +299,24 @@ impl ShadowMapFilter {
             }
         }
     }
+}
+
+/// GBP06's umbra test from the kernel's depth bounds: every sample of the kernel (and its
+/// one-texel border, which contour blocks read) lies in front of the receiver's plane, so the
+/// samples' back-projections cover the light and contours find no edge.
+fn umbra(sm: &ShadowMap, pyramid: &MinMaxPyramid, r: &Receiver, kernel: f64) -> bool {
+    let h = 0.5 * kernel;
+    let (x0, y0, x1, y1) = (
+        (r.x - h).floor() as i64 - 1,
+        (r.y - h).floor() as i64 - 1,
+        (r.x + h).floor() as i64 + 1,
+        (r.y + h).floor() as i64 + 1,
+    );
+    let inside_map = x0 >= 0 && y0 >= 0 && x1 < sm.view.width as i64 && y1 < sm.view.height as i64;
+    inside_map
+        && pyramid
+            .bounds(x0, y0, x1, y1)
+            .is_some_and(|(_, max)| max < r.plane.depth(r.x, r.y, h + 1.5) - r.bias)
 }
 
 /// The unoccluded part of the light, as fractions of its area: `(area, radiance / area)`.
