@@ -140,8 +140,7 @@ impl Backprojection {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::{Affine3A, Vec2};
-    use shadow_core::raster::{Projection, RasterView};
+    use glam::Vec2;
 
     /// BCS06 eq. 1 by hand: an 8 x 8 map over unit-depth [-1, 1]^2 (4 texels per unit), one
     /// occluding texel at depth 1 straight between a receiver at depth 2 and a unit square
@@ -151,25 +150,7 @@ mod tests {
     fn one_sample_back_projects_as_eq1_says() {
         let mut depth = vec![f32::INFINITY; 64];
         depth[4 * 8 + 4] = 1.0;
-        let sm = ShadowMap {
-            view: RasterView {
-                width: 8,
-                height: 8,
-                view_from_world: Affine3A::IDENTITY,
-                projection: Projection::Perspective {
-                    left: -1.0,
-                    right: 1.0,
-                    bottom: -1.0,
-                    top: 1.0,
-                    near: 0.1,
-                },
-            },
-            depth: depth.clone(),
-            texels_per_unit: 4.0,
-            min_depth: 1.0,
-            layers: 1,
-            layered: depth,
-        };
+        let sm = ShadowMap::unit_square(8, depth);
         let light = LightDomain::new(&[
             Vec2::new(-0.5, -0.5),
             Vec2::new(0.5, -0.5),

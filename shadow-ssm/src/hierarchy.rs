@@ -140,8 +140,6 @@ impl MinMaxPyramid {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Affine3A;
-    use shadow_core::raster::{Projection, RasterView};
     use shadow_core::sampling::{hash_words, unit_float};
 
     fn random_map(r: u32) -> ShadowMap {
@@ -155,25 +153,9 @@ mod tests {
                 }
             })
             .collect();
-        ShadowMap {
-            view: RasterView {
-                width: r,
-                height: r,
-                view_from_world: Affine3A::IDENTITY,
-                projection: Projection::Perspective {
-                    left: -1.0,
-                    right: 1.0,
-                    bottom: -1.0,
-                    top: 1.0,
-                    near: 0.1,
-                },
-            },
-            depth: depth.clone(),
-            texels_per_unit: r as f64 / 2.0,
-            min_depth: 1.0,
-            layers: 1,
-            layered: depth,
-        }
+        let mut sm = ShadowMap::unit_square(r, depth);
+        sm.min_depth = 1.0;
+        sm
     }
 
     #[test]

@@ -187,6 +187,34 @@ impl ShadowMap {
     }
 }
 
+#[cfg(test)]
+impl ShadowMap {
+    /// A one-layer `r x r` map over unit-depth `[-1, 1]^2` at the identity view (tests).
+    pub(crate) fn unit_square(r: u32, depth: Vec<f32>) -> Self {
+        use shadow_core::raster::Projection;
+        let min_depth = depth.iter().copied().fold(f32::INFINITY, f32::min);
+        Self {
+            view: RasterView {
+                width: r,
+                height: r,
+                view_from_world: Affine3A::IDENTITY,
+                projection: Projection::Perspective {
+                    left: -1.0,
+                    right: 1.0,
+                    bottom: -1.0,
+                    top: 1.0,
+                    near: 0.1,
+                },
+            },
+            depth: depth.clone(),
+            texels_per_unit: r as f64 / 2.0,
+            min_depth,
+            layers: 1,
+            layered: depth,
+        }
+    }
+}
+
 /// A plane's inverse depth along the shadow map's rays, `a + b X + c Y` at texel coordinates
 /// `(X, Y)` (texel centres at `i + 0.5`); perspective makes it linear, so its extremes over a
 /// block lie at the corners.
