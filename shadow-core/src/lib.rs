@@ -17,6 +17,8 @@
 //! * [`preset`]: named technique configurations with their error budgets.
 //! * [`load`], [`scenes`] and [`procedural`]: glTF and OBJ loading, built-in scenes.
 //! * [`image_io`]: EXR and PNG output.
+//! * `gpu` (feature `gpu`): wgpu device creation with a software fallback, upload, readback
+//!   and naga validation of WGSL, for GPU techniques.
 //!
 //! The visibility coefficient is `V(p) = (1/|L|) * integral of v(p, y) dA(y)` over the light
 //! (DCS eq. 1): the unweighted fraction of the light's area visible from `p`, where `y` below
@@ -40,6 +42,8 @@
 pub mod camera;
 pub mod direct;
 pub mod geometry;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 pub mod image_io;
 pub mod light;
 pub mod load;

@@ -1,0 +1,67 @@
+//! Time against error of AFSM beside the reference on the same samples, per-phase GPU times
+//! and the list statistics of the paper's Fig. 9 inlay, on the adapter the environment selects:
+//! `cargo run --release -p shadow-afsm --example afsm_bench -- [scene] [width] [height] [N]`.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use shadow_afsm::Afsm;
+use shadow_core::metrics::compare;
+use shadow_core::prelude::*;
+use shadow_ref::Reference;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let scene = args.get(1).map_or("bunny", String::as_str);
+    let w: u32 = args.get(2).map_or(Ok(128), |s| s.parse())?;
+    let h: u32 = args.get(3).map_or(Ok(96), |s| s.parse())?;
+    let n: u32 = args.get(4).map_or(Ok(128), |s| s.parse())?;
+    let setup = shadow_core::scenes::builtin(scene)?;
+    let light = Arc::clone(&setup.lights[0]);
+    let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), w, h)?;
+    let mut afsm = Afsm::new(n, SamplingStrategy::Interleaved { tile: 4 }, 1)?;
+    afsm.prepare(setup.scene.clone(), Arc::clone(&light))?;
+    afsm.estimate(&view)?; // warm-up
+    let t0 = Instant::now();
+    let est = afsm.estimate(&view)?;
+    let t_afsm = t0.elapsed().as_secs_f64();
+    let mut r = Reference::same_samples(afsm.light_sampler().expect("soft").clone());
+    r.prepare(setup.scene.clone(), Arc::clone(&light))?;
+    let t0 = Instant::now();
+    let re = r.estimate(&view)?;
+    let t_ref = t0.elapsed().as_secs_f64();
+    let m = compare(&est.visibility, &re.visibility)?;
+    println!("adapter: {}", afsm.adapter().unwrap_or_default());
+    println!(
+        "{scene} {w}x{h} N={n}: afsm {t_afsm:.3} s, reference (same samples, CPU) {t_ref:.3} s, ratio {:.2}",
+        t_ref / t_afsm
+    );
+    println!(
+        "agreement {:.6} rmse {:.5}",
+        m.sample_agreement.unwrap_or(0.0),
+        m.rmse
+    );
+    for p in &est.stats.phases {
+        println!("  phase {:<16} {:.4} s", p.name, p.seconds);
+    }
+    let occupied = est.stats.counter("lists-occupied");
+    let listed = est.stats.counter("receivers-listed");
+    let side = est.stats.counter("map-side");
+    println!(
+        "  lists: {occupied} occupied of {} ({:.1}%), average length {:.2}, longest {}",
+        side * side,
+        100.0 * occupied as f64 / (side * side) as f64,
+        listed as f64 / occupied.max(1) as f64,
+        est.stats.counter("list-length-max")
+    );
+    for k in [
+        "pairs-tested",
+        "pairs-empty",
+        "pairs-full",
+        "pairs-per-sample",
+        "texels-visited",
+    ] {
+        println!("  {k} {}", est.stats.counter(k));
+    }
+    Ok(())
+}

@@ -1,0 +1,330 @@
+//! The compute passes and how one batch of view samples runs through them:
+//!
+//! 1. `count` (section 3.1): project each view sample, atomically take a slot in its texel;
+//! 2. `scan_block` / `scan_add`: the running sum of list lengths gives list offsets;
+//! 3. `scatter`: each view sample's index goes to its list's offset plus its slot;
+//! 4. per batch of caster triangles, `influence` (section 4.1) then `occlude` (sections 3.2,
+//!    3.3, 4.2, 4.3);
+//! 5. `resolve`: horizon test, visible bits, counts and radiance sums.
+//!
+//! Each phase is submitted on its own and waited for, so [`Stats`] holds per-phase GPU times
+//! (submission to completion).
+
+use std::sync::{Arc, OnceLock};
+
+use shadow_core::gpu::{GpuContext, GpuError};
+use shadow_core::technique::Stats;
+
+use crate::params::{Params, Receiver, Region};
+
+/// The shared WGSL prefix.
+pub const COMMON: &str = include_str!("shaders/common.wgsl");
+
+/// Every pass: name, source, and whether it is prefixed with [`COMMON`].
+pub const MODULES: [(&str, &str, bool); 7] = [
+    ("count", include_str!("shaders/count.wgsl"), true),
+    ("scan_block", include_str!("shaders/scan_block.wgsl"), false),
+    ("scan_add", include_str!("shaders/scan_add.wgsl"), false),
+    ("scatter", include_str!("shaders/scatter.wgsl"), true),
+    ("influence", include_str!("shaders/influence.wgsl"), true),
+    ("occlude", include_str!("shaders/occlude.wgsl"), true),
+    ("resolve", include_str!("shaders/resolve.wgsl"), true),
+];
+
+/// The full WGSL source of pass `name`.
+///
+/// # Panics
+/// For a name not in [`MODULES`] (a programming error).
+pub fn source(name: &str) -> String {
+    let (_, src, common) = MODULES
+        .iter()
+        .find(|(n, _, _)| *n == name)
+        .expect("known module");
+    if *common {
+        format!("{COMMON}\n{src}")
+    } else {
+        (*src).to_string()
+    }
+}
+
+/// The compiled pipelines.
+#[derive(Debug)]
+pub struct Pipelines {
+    count: wgpu::ComputePipeline,
+    scan_block: wgpu::ComputePipeline,
+    scan_add: wgpu::ComputePipeline,
+    scatter: wgpu::ComputePipeline,
+    influence: wgpu::ComputePipeline,
+    occlude: wgpu::ComputePipeline,
+    resolve: wgpu::ComputePipeline,
+}
+
+impl Pipelines {
+    /// Validates (naga) and compiles every pass.
+    ///
+    /// # Errors
+    /// [`GpuError::Shader`] or [`GpuError::Device`].
+    pub fn new(gpu: &GpuContext) -> Result<Self, GpuError> {
+        let p = |n: &str| gpu.pipeline(n, &source(n), "main");
+        Ok(Self {
+            count: p("count")?,
+            scan_block: p("scan_block")?,
+            scan_add: p("scan_add")?,
+            scatter: p("scatter")?,
+            influence: p("influence")?,
+            occlude: p("occlude")?,
+            resolve: p("resolve")?,
+        })
+    }
+
+    /// The pipelines of the shared context, compiled once.
+    ///
+    /// # Errors
+    /// As [`GpuContext::shared`] and [`Pipelines::new`].
+    pub fn shared() -> Result<(Arc<GpuContext>, Arc<Pipelines>), GpuError> {
+        static PIPES: OnceLock<Result<Arc<Pipelines>, GpuError>> = OnceLock::new();
+        let gpu = GpuContext::shared()?;
+        let pipes = PIPES
+            .get_or_init(|| Pipelines::new(&gpu).map(Arc::new))
+            .clone()?;
+        Ok((gpu, pipes))
+    }
+}
+
+/// Exclusive prefix sum of the first `n` values of `data`, in place (recursive over block
+/// totals). Buffers that must outlive the submission go into `keep`.
+///
+/// # Errors
+/// As [`GpuContext::dispatch`].
+pub fn scan(
+    gpu: &GpuContext,
+    pipes: &Pipelines,
+    enc: &mut wgpu::CommandEncoder,
+    data: &wgpu::Buffer,
+    n: u32,
+    keep: &mut Vec<wgpu::Buffer>,
+) -> Result<(), GpuError> {
+    let blocks = n.div_ceil(512).max(1);
+    let sums = gpu.storage_zeroed("scan sums", blocks as u64 * 4)?;
+    let uni = gpu.uniform("scan n", &[n, 0u32, 0, 0]);
+    let bind = gpu.bind(&pipes.scan_block, &[&uni, data, &sums]);
+    gpu.dispatch(enc, &pipes.scan_block, &bind, blocks as u64)?;
+    if blocks > 1 {
+        scan(gpu, pipes, enc, &sums, blocks, keep)?;
+        let bind = gpu.bind(&pipes.scan_add, &[&uni, data, &sums]);
+        gpu.dispatch(enc, &pipes.scan_add, &bind, (n as u64).div_ceil(64))?;
+    }
+    keep.push(sums);
+    keep.push(uni);
+    Ok(())
+}
+
+/// Caster triangles uploaded in batches that respect the binding limits.
+#[derive(Debug)]
+pub struct CasterBatch {
+    /// The triangles.
+    pub buffer: wgpu::Buffer,
+    /// How many.
+    pub len: u32,
+}
+
+/// What one batch of view samples needs beyond its receivers.
+#[derive(Debug)]
+pub struct Shared<'a> {
+    /// Caster batches.
+    pub casters: &'a [CasterBatch],
+    /// Light sample positions (`sets * N` vec4).
+    pub samples: &'a wgpu::Buffer,
+    /// Light sample radiance (same layout).
+    pub radiance: &'a wgpu::Buffer,
+    /// The plane table (a dummy in exact mode).
+    pub lut: &'a wgpu::Buffer,
+}
+
+/// Occlusion-pass tallies, in the order the shader keeps them.
+pub const TALLIES: [&str; 6] = [
+    "texels-visited",
+    "pairs-tested",
+    "pairs-empty",
+    "pairs-full",
+    "pairs-per-sample",
+    "pairs-own-triangle",
+];
+
+/// What a batch of view samples gives back.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BatchOutput {
+    /// Per receiver: radiance sum of visible samples (xyz), visible count (w).
+    pub result: Vec<[f32; 4]>,
+    /// Per receiver: `W` words of visible bits.
+    pub visible: Vec<u32>,
+    /// List offsets (`side^2 + 1`, the last one the total).
+    pub offsets: Vec<u32>,
+    /// The influence regions of the last caster batch (kept for tests).
+    pub regions: Vec<Region>,
+    /// The occlusion tallies ([`TALLIES`]).
+    pub tallies: [u64; 6],
+}
+
+/// Runs every pass for one batch of receivers; `params` holds the frame, light and sizes
+/// (`dims[1]` is set here).
+///
+/// # Errors
+/// [`GpuError`] from any pass.
+pub fn run_batch(
+    gpu: &GpuContext,
+    pipes: &Pipelines,
+    mut params: Params,
+    receivers: &[Receiver],
+    shared: &Shared<'_>,
+    keep_regions: bool,
+    stats: &mut Stats,
+) -> Result<BatchOutput, GpuError> {
+    let n = receivers.len() as u32;
+    params.dims[1] = n;
+    let side = params.dims[0];
+    let words = params.dims[3];
+    let texels = side * side;
+    let mut keep = Vec::new();
+    let (rbuf, counts, slots, lists, masks, result, tallies) = stats.time("gpu-upload", || {
+        Ok::<_, GpuError>((
+            gpu.storage("receivers", receivers)?,
+            gpu.storage_zeroed("list counts", (texels as u64 + 1) * 4)?,
+            gpu.storage_zeroed("slots", n as u64 * 8)?,
+            gpu.storage_zeroed("lists", n as u64 * 4)?,
+            gpu.storage_zeroed("masks", n as u64 * words as u64 * 4)?,
+            gpu.storage_zeroed("result", n as u64 * 16)?,
+            gpu.storage_zeroed("tallies", 12 * 4)?,
+        ))
+    })?;
+    let uni = gpu.uniform("params", &params);
+    let groups = (n as u64).div_ceil(64);
+    stats.time("gpu-lists", || {
+        let mut enc = gpu.encoder();
+        let b = gpu.bind(&pipes.count, &[&uni, &rbuf, &counts, &slots]);
+        gpu.dispatch(&mut enc, &pipes.count, &b, groups)?;
+        scan(gpu, pipes, &mut enc, &counts, texels + 1, &mut keep)?;
+        gpu.submit(enc)?;
+        let mut enc = gpu.encoder();
+        let b = gpu.bind(&pipes.scatter, &[&uni, &slots, &counts, &lists]);
+        gpu.dispatch(&mut enc, &pipes.scatter, &b, groups)?;
+        gpu.submit(enc)
+    })?;
+    let largest = shared.casters.iter().map(|c| c.len).max().unwrap_or(0);
+    let regions = gpu.storage_zeroed(
+        "regions",
+        largest as u64 * std::mem::size_of::<Region>() as u64,
+    )?;
+    let mut last_regions = Vec::new();
+    for batch in shared.casters {
+        let mut p = params;
+        p.kind[0] = batch.len;
+        let uni = gpu.uniform("params", &p);
+        stats.time("gpu-influence", || {
+            let mut enc = gpu.encoder();
+            let b = gpu.bind(&pipes.influence, &[&uni, &batch.buffer, &regions]);
+            gpu.dispatch(
+                &mut enc,
+                &pipes.influence,
+                &b,
+                (batch.len as u64).div_ceil(64),
+            )?;
+            gpu.submit(enc)
+        })?;
+        if keep_regions {
+            last_regions = gpu.read::<Region>(&regions, batch.len as usize)?;
+        }
+        stats.time("gpu-occlude", || {
+            let mut enc = gpu.encoder();
+            let b = gpu.bind(
+                &pipes.occlude,
+                &[
+                    &uni,
+                    &batch.buffer,
+                    &regions,
+                    &rbuf,
+                    &counts,
+                    &lists,
+                    shared.samples,
+                    &masks,
+                    &tallies,
+                    shared.lut,
+                ],
+            );
+            gpu.dispatch(&mut enc, &pipes.occlude, &b, batch.len as u64)?;
+            gpu.submit(enc)
+        })?;
+    }
+    stats.time("gpu-resolve", || {
+        let mut enc = gpu.encoder();
+        let b = gpu.bind(
+            &pipes.resolve,
+            &[
+                &uni,
+                &rbuf,
+                shared.samples,
+                shared.radiance,
+                &masks,
+                &result,
+            ],
+        );
+        gpu.dispatch(&mut enc, &pipes.resolve, &b, groups)?;
+        gpu.submit(enc)
+    })?;
+    stats.time("gpu-readback", || {
+        let t: Vec<u32> = gpu.read(&tallies, 12)?;
+        let mut tallies = [0u64; 6];
+        for (k, v) in tallies.iter_mut().enumerate() {
+            *v = t[2 * k] as u64 | (t[2 * k + 1] as u64) << 32;
+        }
+        Ok(BatchOutput {
+            result: gpu.read(&result, n as usize)?,
+            visible: gpu.read(&masks, (n * words) as usize)?,
+            offsets: gpu.read(&counts, texels as usize + 1)?,
+            regions: last_regions,
+            tallies,
+        })
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every pass is valid WGSL for naga (no device needed).
+    #[test]
+    fn every_module_validates_with_naga() {
+        for (name, _, _) in MODULES {
+            if let Err(e) = shadow_core::gpu::validate_wgsl(&source(name)) {
+                panic!("{name}: {e}");
+            }
+        }
+    }
+
+    /// The GPU scan against a CPU running sum, over sizes around the block boundaries and one
+    /// needing two levels of block totals.
+    #[test]
+    fn gpu_scan_equals_the_cpu_running_sum() {
+        let Some(gpu) = shadow_core::gpu::context_for_test("gpu_scan_equals_the_cpu_running_sum")
+        else {
+            return;
+        };
+        let pipes = Pipelines::new(&gpu).unwrap();
+        for n in [1u32, 511, 512, 513, 4097, 300_001] {
+            let data: Vec<u32> = (0..n)
+                .map(|i| i.wrapping_mul(2_654_435_761u32) >> 28)
+                .collect();
+            let buf = gpu.storage("data", &data).unwrap();
+            let mut keep = Vec::new();
+            let mut enc = gpu.encoder();
+            scan(&gpu, &pipes, &mut enc, &buf, n, &mut keep).unwrap();
+            gpu.submit(enc).unwrap();
+            let got: Vec<u32> = gpu.read(&buf, n as usize).unwrap();
+            let mut acc = 0u32;
+            for (i, v) in data.iter().enumerate() {
+                assert_eq!(got[i], acc, "n {n} at {i}");
+                acc += v;
+            }
+        }
+    }
+}

@@ -1,0 +1,108 @@
+// Shared definitions of the AFSM compute passes (Sintorn, Eisemann and Assarsson 2008). Every
+// module is this file followed by one pass; the Rust side mirrors `Params` in `params.rs`.
+
+struct Params {
+    // Light frame (section 4.3): centre, two axes spanning the map plane, the frustum axis
+    // (w = far plane distance), and the projected box: x0, y0, texels per unit in x and y.
+    center: vec4<f32>,
+    axis_u: vec4<f32>,
+    axis_v: vec4<f32>,
+    axis_d: vec4<f32>,
+    map: vec4<f32>,
+    // The light: plane normal (planar lights), w = radius (disk, sphere) or bounding radius.
+    light_n: vec4<f32>,
+    // The light's own in-plane axes (disk octagon, LUT frame); w of light_u = bounding radius.
+    light_u: vec4<f32>,
+    light_v: vec4<f32>,
+    // side, listed receivers, samples per set N, words per receiver W.
+    dims: vec4<u32>,
+    // caster triangles in this batch, light kind (0 polygon points, 1 disk, 2 sphere, 3 point),
+    // number of outline points, LUT mode (1 = lookup table).
+    kind: vec4<u32>,
+    // LUT bins in theta, phi, delta; 1 when the light is textured.
+    lut: vec4<u32>,
+    // Up to 8 points bounding the light (rectangle corners, polygon outline or its box).
+    outline: array<vec4<f32>, 8>,
+}
+
+// Integers live in their own u32 fields (never bit-cast into floats: a small integer's bits are
+// a denormal float, which some drivers flush to zero).
+struct Receiver {
+    // Ray origin (offset off the surface as the reference does) and sample set index.
+    origin: vec3<f32>,
+    set_index: u32,
+    // Surface point and the receiver's own triangle.
+    position: vec3<f32>,
+    triangle: u32,
+    // Geometric normal.
+    normal: vec3<f32>,
+    pad: u32,
+}
+
+struct Caster {
+    // Vertices, the triangle id, and 1 when its mesh is closed.
+    a: vec3<f32>,
+    id: u32,
+    b: vec3<f32>,
+    closed: u32,
+    c: vec3<f32>,
+    pad: u32,
+}
+
+const MAX_HULL: u32 = 28u;
+
+struct Region {
+    // Texel box (x0, y0, x1, y1), inclusive.
+    bbox: vec4<i32>,
+    // Hull vertex count (0 = culled), whole map flag, pad, pad.
+    info: vec4<u32>,
+    pts: array<vec2<f32>, 28>,
+}
+
+// Linear index of an invocation in a (possibly 2D-split) dispatch of 64-wide workgroups.
+fn linear_index(g: vec3<u32>, n: vec3<u32>) -> u32 {
+    return g.y * n.x * 64u + g.x;
+}
+
+// Projected map coordinates (before texel scaling) of a world point; z in w.
+fn project(p: vec3<f32>) -> vec3<f32> {
+    let q = p - P.center.xyz;
+    let z = dot(q, P.axis_d.xyz);
+    return vec3<f32>(dot(q, P.axis_u.xyz) / z, dot(q, P.axis_v.xyz) / z, z);
+}
+
+// Continuous texel coordinates of projected map coordinates.
+fn to_texel(xy: vec2<f32>) -> vec2<f32> {
+    return (xy - P.map.xy) * P.map.zw;
+}
+
+// Range of dot(m, y) over the light's surface (its support function both ways).
+fn light_range(m: vec3<f32>) -> vec2<f32> {
+    let c = dot(m, P.center.xyz);
+    switch P.kind.y {
+        case 1u: {
+            // Disk: the component of m in the disk's plane, times the radius.
+            let n = P.light_n.xyz;
+            let t = m - dot(m, n) * n;
+            let h = P.light_n.w * length(t);
+            return vec2<f32>(c - h, c + h);
+        }
+        case 2u: {
+            let h = P.light_n.w * length(m);
+            return vec2<f32>(c - h, c + h);
+        }
+        case 3u: {
+            return vec2<f32>(c, c);
+        }
+        default: {
+            var lo = 3.4e38;
+            var hi = -3.4e38;
+            for (var k = 0u; k < P.kind.z; k++) {
+                let d = dot(m, P.outline[k].xyz);
+                lo = min(lo, d);
+                hi = max(hi, d);
+            }
+            return vec2<f32>(lo, hi);
+        }
+    }
+}

@@ -1,0 +1,186 @@
+// Section 4.1: each caster triangle's influence region in the shadow map. For every vertex v
+// and every point y bounding the light (rectangle corners, polygon outline, the octagon around
+// a disk; for spheres the hexagon around the light's silhouette circle seen from v), the line
+// from y through v meets the far plane (the farthest listed view sample) at f; the convex
+// hull of the projections of the vertices and of every f bounds the texels whose view samples
+// the triangle can shadow. A point light gives the triangle's own projection (section 3).
+// Conservative back-face culling for closed meshes (section 4.3, [ED07]): a triangle whose
+// supporting plane has the whole light on its front side is never a light back-facing caster.
+
+@group(0) @binding(0) var<uniform> P: Params;
+@group(0) @binding(1) var<storage, read> casters: array<Caster>;
+@group(0) @binding(2) var<storage, read_write> regions: array<Region>;
+
+fn cross2(o: vec2<f32>, a: vec2<f32>, b: vec2<f32>) -> f32 {
+    return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+}
+
+fn whole_map(t: u32) {
+    let s = i32(P.dims.x) - 1;
+    regions[t].bbox = vec4<i32>(0, 0, s, s);
+    regions[t].info = vec4<u32>(0u, 1u, 0u, 0u);
+}
+
+fn culled(t: u32) {
+    regions[t].bbox = vec4<i32>(0, 0, -1, -1);
+    regions[t].info = vec4<u32>(0u, 0u, 0u, 0u);
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n: vec3<u32>) {
+    let t = linear_index(g, n);
+    if t >= P.kind.x {
+        return;
+    }
+    let tri = casters[t];
+    var v = array<vec3<f32>, 3>(tri.a, tri.b, tri.c);
+    let nt = cross(v[1] - v[0], v[2] - v[0]);
+    let closed = tri.closed == 1u;
+    let r = light_range(nt) - dot(nt, v[0]);
+    if closed && r.x > 0.0 {
+        culled(t);
+        return;
+    }
+    let zfar = P.axis_d.w;
+    let d = P.axis_d.xyz;
+    let c = P.center.xyz;
+    var zmin = 3.4e38;
+    for (var k = 0u; k < 3u; k++) {
+        zmin = min(zmin, dot(v[k] - c, d));
+    }
+    if zmin > zfar {
+        // Beyond every listed view sample: it shadows none of them.
+        culled(t);
+        return;
+    }
+    var pts: array<vec2<f32>, 28>;
+    var m = 0u;
+    for (var k = 0u; k < 3u; k++) {
+        let vk = v[k];
+        let zv = dot(vk - c, d);
+        if zv <= 1e-6 * zfar {
+            whole_map(t);
+            return;
+        }
+        pts[m] = to_texel(project(vk).xy);
+        m++;
+        // The points bounding the light as seen through this vertex.
+        var ys: array<vec3<f32>, 8>;
+        var ny = 0u;
+        switch P.kind.y {
+            case 1u: {
+                let rad = P.light_n.w / cos(3.14159265 / 8.0);
+                for (var j = 0u; j < 8u; j++) {
+                    let a = f32(j) * 3.14159265 / 4.0;
+                    ys[j] = c + rad * (cos(a) * P.light_u.xyz + sin(a) * P.light_v.xyz);
+                }
+                ny = 8u;
+            }
+            case 2u: {
+                // Silhouette circle of the sphere seen from vk (centre, radius, plane), and the
+                // regular hexagon around it (section 4.1).
+                let rs = P.light_n.w;
+                let w = vk - c;
+                let l2 = dot(w, w);
+                if l2 <= rs * rs * 1.0001 {
+                    whole_map(t);
+                    return;
+                }
+                let axis = w / sqrt(l2);
+                let mid = c + (rs * rs / l2) * w;
+                let rho = rs * sqrt(max(1.0 - rs * rs / l2, 0.0));
+                var e1 = cross(axis, vec3<f32>(0.0, 1.0, 0.0));
+                if dot(e1, e1) < 1e-6 {
+                    e1 = cross(axis, vec3<f32>(1.0, 0.0, 0.0));
+                }
+                e1 = normalize(e1);
+                let e2 = cross(axis, e1);
+                let rad = rho / cos(3.14159265 / 6.0);
+                for (var j = 0u; j < 6u; j++) {
+                    let a = f32(j) * 3.14159265 / 3.0;
+                    ys[j] = mid + rad * (cos(a) * e1 + sin(a) * e2);
+                }
+                ny = 6u;
+            }
+            case 3u: {
+                ny = 0u;
+            }
+            default: {
+                for (var j = 0u; j < P.kind.z; j++) {
+                    ys[j] = P.outline[j].xyz;
+                }
+                ny = P.kind.z;
+            }
+        }
+        for (var j = 0u; j < ny; j++) {
+            let zy = dot(ys[j] - c, d);
+            if zv - zy <= 1e-6 * zfar {
+                whole_map(t);
+                return;
+            }
+            let s = (zfar - zv) / (zv - zy);
+            let f = vk + s * (vk - ys[j]);
+            let q = f - c;
+            pts[m] = to_texel(vec2<f32>(dot(q, P.axis_u.xyz), dot(q, P.axis_v.xyz)) / zfar);
+            m++;
+        }
+    }
+    // Bounding box, then the convex hull (monotone chain after an insertion sort by x, y).
+    var lo = pts[0];
+    var hi = pts[0];
+    for (var k = 1u; k < m; k++) {
+        lo = min(lo, pts[k]);
+        hi = max(hi, pts[k]);
+    }
+    let side = f32(P.dims.x);
+    let eps = 1e-3;
+    if hi.x < -eps || hi.y < -eps || lo.x > side + eps || lo.y > side + eps {
+        culled(t);
+        return;
+    }
+    let s1 = i32(P.dims.x) - 1;
+    regions[t].bbox = vec4<i32>(
+        clamp(i32(floor(lo.x - eps)), 0, s1),
+        clamp(i32(floor(lo.y - eps)), 0, s1),
+        clamp(i32(floor(hi.x + eps)), 0, s1),
+        clamp(i32(floor(hi.y + eps)), 0, s1));
+    for (var i = 1u; i < m; i++) {
+        let p = pts[i];
+        var j = i;
+        while j > 0u && (pts[j - 1u].x > p.x || (pts[j - 1u].x == p.x && pts[j - 1u].y > p.y)) {
+            pts[j] = pts[j - 1u];
+            j--;
+        }
+        pts[j] = p;
+    }
+    var hull: array<vec2<f32>, 29>;
+    var h = 0u;
+    for (var i = 0u; i < m; i++) {
+        while h >= 2u && cross2(hull[h - 2u], hull[h - 1u], pts[i]) <= 0.0 {
+            h--;
+        }
+        hull[h] = pts[i];
+        h++;
+    }
+    let lower = h + 1u;
+    for (var ii = 1u; ii < m; ii++) {
+        let i = m - 1u - ii;
+        while h >= lower && cross2(hull[h - 2u], hull[h - 1u], pts[i]) <= 0.0 {
+            h--;
+        }
+        hull[h] = pts[i];
+        h++;
+    }
+    if h > 1u {
+        h--;
+    }
+    if h < 3u {
+        // Degenerate (a triangle seen edge-on from a point light): the box alone.
+        regions[t].info = vec4<u32>(0u, 2u, 0u, 0u);
+        return;
+    }
+    for (var k = 0u; k < h; k++) {
+        regions[t].pts[k] = hull[k];
+    }
+    regions[t].info = vec4<u32>(h, 0u, 0u, 0u);
+}

@@ -1,0 +1,622 @@
+//! The [`Afsm`] technique: alias-free shadow maps and sample-based soft shadows (Sintorn,
+//! Eisemann and Assarsson 2008) in wgpu compute shaders.
+//!
+//! Per estimate:
+//! * CPU: the view samples whose tangent plane leaves part of the light above (light
+//!   front-facing, section 3) become receivers, with the reference's offset ray origin
+//!   ([`shadow_core::offset`]); the others are 0 with no work. Receivers go to the GPU in
+//!   batches whose buffers respect the device's binding limit, each with its own fitted light
+//!   frustum ([`crate::frame`], section 4.3).
+//! * GPU: lists, influence regions, occlusion and resolve ([`crate::passes`]).
+//! * CPU: visibility `V = visible / N` (DCS eq. 1), or the radiance-weighted sum for textured
+//!   lights (DCS eq. 2), per-sample bits and classes.
+//!
+//! Light samples are shared sets (one set, or `k x k` interleaved sets), as the lookup table of
+//! section 4.2 needs a fixed set; [`Afsm::set_frame`] rotates them for temporal jittering
+//! (section 4.2, Fig. 7), see [`crate::temporal`].
+//!
+//! Semi-opaque occluders are refused: a bit per light sample records binary visibility, and the
+//! paper's approximate transparency (section 6) is left as future work there.
+
+use std::sync::Arc;
+
+use glam::{UVec2, Vec3};
+use serde_json::json;
+use shadow_core::gpu::{GpuContext, GpuError, check_finite, gpu_required};
+use shadow_core::light::LightKind;
+use shadow_core::offset::RayOffset;
+use shadow_core::prelude::*;
+use shadow_core::sampling::hash_words;
+use shadow_core::technique::{Capabilities, Processor, SceneRef};
+use shadow_core::visibility::{PerSampleVisibility, PixelClass};
+
+use crate::frame::MapFrame;
+use crate::lut::PlaneLut;
+use crate::params::{Caster, LightBounds, Params, Receiver, Region};
+use crate::passes::{CasterBatch, Pipelines, Shared, TALLIES, run_batch};
+
+/// How the occlusion pass finds the samples behind a plane (section 4.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PlaneTest {
+    /// Every sample tested against every plane that cuts the light.
+    Exact,
+    /// The 3D lookup table of section 4.2 (one shared sample set).
+    Lut,
+}
+
+/// Largest sample count per view sample.
+pub const MAX_SAMPLES: u32 = 1024;
+
+struct Prepared {
+    scene: SceneRef,
+    light: Light,
+    gpu: Arc<GpuContext>,
+    pipes: Arc<Pipelines>,
+    bounds: LightBounds,
+    offset: RayOffset,
+    batches: Vec<CasterBatch>,
+    samples: wgpu::Buffer,
+    radiance: wgpu::Buffer,
+    lut: wgpu::Buffer,
+    sample_positions: Vec<Vec3>,
+}
+
+/// Receivers in batches of at most `per_batch`, each with its fitted frustum. When one
+/// frustum cannot hold a batch (view samples all around an omni-directional light), the batch
+/// is split by the cube face its samples lie toward, one frustum per face (each spans at most
+/// 55 degrees from its axis).
+#[allow(clippy::type_complexity)]
+fn group_receivers(
+    center: Vec3,
+    receivers: &[Receiver],
+    pixels: &[usize],
+    per_batch: usize,
+    side: u32,
+) -> Vec<(Vec<Receiver>, Vec<usize>, MapFrame)> {
+    let mut out = Vec::new();
+    for (chunk, px) in receivers.chunks(per_batch).zip(pixels.chunks(per_batch)) {
+        let origins: Vec<Vec3> = chunk.iter().map(|r| r.origin()).collect();
+        if let Ok(f) = MapFrame::fit(center, &origins, side) {
+            out.push((chunk.to_vec(), px.to_vec(), f));
+            continue;
+        }
+        let mut faces: [(Vec<Receiver>, Vec<usize>, Vec<Vec3>); 6] = Default::default();
+        for ((r, &i), o) in chunk.iter().zip(px).zip(&origins) {
+            let q = *o - center;
+            let a = q.abs();
+            let face = if a.x >= a.y && a.x >= a.z {
+                (q.x < 0.0) as usize
+            } else if a.y >= a.z {
+                2 + (q.y < 0.0) as usize
+            } else {
+                4 + (q.z < 0.0) as usize
+            };
+            faces[face].0.push(*r);
+            faces[face].1.push(i);
+            faces[face].2.push(*o);
+        }
+        for (r, i, o) in faces {
+            if r.is_empty() {
+                continue;
+            }
+            // A cube face spans at most 54.7 degrees from its axis: the fit cannot fail for
+            // points off the centre; points at the centre itself have no direction and are
+            // fitted with the rest of their face.
+            if let Ok(f) = MapFrame::fit(center, &o, side) {
+                out.push((r, i, f));
+            }
+        }
+    }
+    out
+}
+
+/// Alias-free shadow maps (hard) and sample-based visibility (soft) on wgpu.
+pub struct Afsm {
+    name: String,
+    samples: u32,
+    strategy: SamplingStrategy,
+    seed: u64,
+    frame: u64,
+    sampler: LightSampler,
+    hard: bool,
+    plane_test: PlaneTest,
+    memory_limit: Option<u64>,
+    prepared: Option<Prepared>,
+}
+
+impl std::fmt::Debug for Afsm {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Afsm")
+            .field("name", &self.name)
+            .field("samples", &self.samples)
+            .field("plane_test", &self.plane_test)
+            .finish_non_exhaustive()
+    }
+}
+
+fn device_error(e: GpuError) -> TechniqueError {
+    TechniqueError::Device(e.to_string())
+}
+
+impl Afsm {
+    /// Soft shadows with `samples` light samples per view sample (1 to 1024) drawn by
+    /// `strategy`, which must share sets between view samples (correlated or interleaved).
+    ///
+    /// # Errors
+    /// [`TechniqueError::InvalidInput`] for a count outside 1..=1024 or a per-pixel strategy.
+    pub fn new(
+        samples: u32,
+        strategy: SamplingStrategy,
+        seed: u64,
+    ) -> Result<Self, TechniqueError> {
+        if samples == 0 || samples > MAX_SAMPLES {
+            return Err(TechniqueError::InvalidInput(format!(
+                "AFSM takes 1 to {MAX_SAMPLES} samples per view sample, got {samples}"
+            )));
+        }
+        if !matches!(
+            strategy,
+            SamplingStrategy::Correlated | SamplingStrategy::Interleaved { .. }
+        ) {
+            return Err(TechniqueError::InvalidInput(format!(
+                "AFSM shares light sample sets between view samples (section 4.2); {strategy:?} \
+                 draws a set per pixel: use Correlated or Interleaved"
+            )));
+        }
+        let sampler = LightSampler::new(strategy, samples, seed)
+            .map_err(|e| TechniqueError::InvalidInput(e.to_string()))?;
+        Ok(Self {
+            name: format!("afsm-{samples}"),
+            samples,
+            strategy,
+            seed,
+            frame: 0,
+            sampler,
+            hard: false,
+            plane_test: PlaneTest::Exact,
+            memory_limit: None,
+            prepared: None,
+        })
+    }
+
+    /// Hard shadows from the light's centre (section 3): one bit per view sample.
+    pub fn hard() -> Self {
+        let mut a = Self::new(1, SamplingStrategy::Correlated, 0).expect("one sample is valid");
+        a.hard = true;
+        a.name = "afsm-hard".into();
+        a
+    }
+
+    /// Uses the plane lookup table (needs a single shared set: correlated sampling).
+    ///
+    /// # Errors
+    /// [`TechniqueError::InvalidInput`] with interleaved sets.
+    pub fn with_lut(mut self) -> Result<Self, TechniqueError> {
+        if self.strategy != SamplingStrategy::Correlated || self.hard {
+            return Err(TechniqueError::InvalidInput(
+                "the plane lookup table holds one sample set: use correlated sampling".into(),
+            ));
+        }
+        self.plane_test = PlaneTest::Lut;
+        Ok(self)
+    }
+
+    /// Caps every GPU buffer at `bytes` (below the device's own limit), forcing the receiver
+    /// and caster splitting a smaller device would need.
+    pub fn with_memory_limit(mut self, bytes: u64) -> Self {
+        self.memory_limit = Some(bytes);
+        self
+    }
+
+    /// Renames the technique.
+    pub fn named(mut self, name: &str) -> Self {
+        self.name = name.into();
+        self
+    }
+
+    /// The current frame of temporal jittering.
+    pub fn frame(&self) -> u64 {
+        self.frame
+    }
+
+    /// Moves to frame `k` of temporal jittering: frame 0 uses the seed's sets, every other
+    /// frame a fresh set from a hash of the seed and `k` (section 4.2, Fig. 7).
+    ///
+    /// # Errors
+    /// [`TechniqueError::Device`] when the new samples (and table) cannot be uploaded.
+    pub fn set_frame(&mut self, k: u64) -> Result<(), TechniqueError> {
+        let seed = if k == 0 {
+            self.seed
+        } else {
+            hash_words(&[self.seed, 0x7e3f, k])
+        };
+        self.frame = k;
+        self.sampler = LightSampler::new(self.strategy, self.samples, seed)
+            .map_err(|e| TechniqueError::InvalidInput(e.to_string()))?;
+        if let Some(p) = self.prepared.take() {
+            let light = p.light.clone();
+            let scene = p.scene.clone();
+            self.prepared = Some(self.build(scene, light)?);
+        }
+        Ok(())
+    }
+
+    fn words(&self) -> u32 {
+        self.samples.div_ceil(32)
+    }
+
+    fn binding_limit(&self, gpu: &GpuContext) -> u64 {
+        let device = gpu.max_binding();
+        self.memory_limit.map_or(device, |m| m.min(device))
+    }
+
+    /// The sets of light samples: one per interleaving cell (or one).
+    fn sets(&self, light: &dyn AreaLight) -> Vec<Vec<LightSample>> {
+        if self.hard {
+            let c = light.center();
+            return vec![vec![LightSample {
+                position: c,
+                normal: Vec3::ZERO,
+                uv: glam::Vec2::splat(0.5),
+                radiance: light.radiance().mean(),
+            }]];
+        }
+        let tile = match self.strategy {
+            SamplingStrategy::Interleaved { tile } => tile,
+            _ => 1,
+        };
+        let mut out = Vec::new();
+        for k in 0..tile * tile {
+            let mut s = Vec::new();
+            self.sampler
+                .light_samples(light, UVec2::new(k % tile, k / tile), &mut s);
+            out.push(s);
+        }
+        out
+    }
+
+    fn set_of(&self, pixel: UVec2) -> u32 {
+        match self.strategy {
+            SamplingStrategy::Interleaved { tile } if !self.hard => {
+                (pixel.y % tile) * tile + pixel.x % tile
+            }
+            _ => 0,
+        }
+    }
+
+    fn build(&self, scene: SceneRef, light: Light) -> Result<Prepared, TechniqueError> {
+        let (gpu, pipes) = Pipelines::shared().map_err(device_error)?;
+        let bounds = LightBounds::new(light.as_ref(), self.hard);
+        check_finite(&bounds.floats(), "light bounds").map_err(device_error)?;
+        let topo = scene.topology();
+        let closed: Vec<bool> = topo
+            .components()
+            .iter()
+            .map(|c| c.closed && c.consistently_oriented)
+            .collect();
+        let casters: Vec<Caster> = (0..scene.triangle_count())
+            .map(|t| Caster::new(scene.triangle(t), t as u32, closed[topo.component_of(t)]))
+            .collect();
+        let limit = self.binding_limit(&gpu);
+        let per = (limit / std::mem::size_of::<Region>() as u64).max(1) as usize;
+        let batches = casters
+            .chunks(per)
+            .map(|c| {
+                Ok(CasterBatch {
+                    buffer: gpu.storage("casters", c)?,
+                    len: c.len() as u32,
+                })
+            })
+            .collect::<Result<Vec<_>, GpuError>>()
+            .map_err(device_error)?;
+        let sets = self.sets(light.as_ref());
+        let positions: Vec<[f32; 4]> = sets
+            .iter()
+            .flatten()
+            .map(|s| [s.position.x, s.position.y, s.position.z, 1.0])
+            .collect();
+        let radiance: Vec<[f32; 4]> = sets
+            .iter()
+            .flatten()
+            .map(|s| [s.radiance.x, s.radiance.y, s.radiance.z, 0.0])
+            .collect();
+        check_finite(positions.as_flattened(), "light samples").map_err(device_error)?;
+        check_finite(radiance.as_flattened(), "light sample radiance").map_err(device_error)?;
+        let sample_positions: Vec<Vec3> = sets.iter().flatten().map(|s| s.position).collect();
+        let lut_data = match self.plane_test {
+            PlaneTest::Lut => PlaneLut::build(&bounds, &sample_positions).data,
+            PlaneTest::Exact => vec![0u32; 4],
+        };
+        let up = || -> Result<_, GpuError> {
+            Ok((
+                gpu.storage("light samples", &positions)?,
+                gpu.storage("light radiance", &radiance)?,
+                gpu.storage("plane table", &lut_data)?,
+            ))
+        };
+        let (samples, radiance, lut) = up().map_err(device_error)?;
+        let extent = scene.bounds().diagonal();
+        Ok(Prepared {
+            scene,
+            light,
+            gpu,
+            pipes,
+            bounds,
+            offset: RayOffset::for_extent(extent),
+            batches,
+            samples,
+            radiance,
+            lut,
+            sample_positions,
+        })
+    }
+
+    /// The adapter the technique runs on, once prepared.
+    pub fn adapter(&self) -> Option<String> {
+        self.prepared.as_ref().map(|p| p.gpu.describe())
+    }
+
+    /// The sample positions of the current frame (all sets, in set order).
+    pub fn sample_positions(&self) -> Option<&[Vec3]> {
+        self.prepared
+            .as_ref()
+            .map(|p| p.sample_positions.as_slice())
+    }
+
+    /// Runs the passes on `view`, keeping the last caster batch's influence regions when
+    /// `keep_regions` (for stage tests). Returns the estimate, the receivers, their map frames
+    /// and regions per batch.
+    #[allow(clippy::type_complexity)]
+    pub fn run(
+        &self,
+        view: &ViewSamples,
+        keep_regions: bool,
+    ) -> Result<
+        (
+            Estimate,
+            Vec<Receiver>,
+            Vec<(MapFrame, Vec<Region>, Vec<u32>)>,
+        ),
+        TechniqueError,
+    > {
+        let p = self
+            .prepared
+            .as_ref()
+            .ok_or_else(|| TechniqueError::NotPrepared(self.name.clone()))?;
+        let _gpu = p.gpu.exclusive();
+        let mut stats = Stats::default();
+        let n = self.samples;
+        let words = self.words();
+        let textured = p.light.is_textured() && !self.hard;
+        // Receivers: light front-facing view samples (section 3).
+        let (receivers, pixels, facing_away) = stats.time("receivers", || {
+            let mut r = Vec::new();
+            let mut px = Vec::new();
+            let mut away = 0u64;
+            for i in 0..view.len() {
+                let Some(s) = view.get(i) else { continue };
+                let nrm = s.geometric_normal;
+                let origin = p.offset.offset(s.position, nrm);
+                let (_, hi_p) = p.bounds.range(nrm);
+                let above_p = hi_p - nrm.dot(s.position) > 0.0;
+                let above_o = hi_p - nrm.dot(origin) > 0.0;
+                if !(above_p && above_o) {
+                    away += 1;
+                    continue;
+                }
+                r.push(Receiver::new(
+                    origin,
+                    self.set_of(s.pixel),
+                    s.position,
+                    s.triangle,
+                    nrm,
+                ));
+                px.push(i);
+            }
+            (r, px, away)
+        });
+        let floats: Vec<f32> = receivers.iter().flat_map(|r| r.floats()).collect();
+        check_finite(&floats, "view samples").map_err(device_error)?;
+        // Batches of receivers within the binding limit.
+        let limit = self.binding_limit(&p.gpu);
+        let per_receiver = (words as u64 * 4).max(std::mem::size_of::<Receiver>() as u64);
+        let per_batch = (limit / per_receiver).max(1) as usize;
+        let side = view.width().max(view.height()).clamp(8, 4096);
+        let side = (1..=side)
+            .rev()
+            .find(|s| (*s as u64 * *s as u64 + 1) * 4 <= limit)
+            .unwrap_or(1);
+        let mut params = Params {
+            dims: [side, 0, n, words],
+            lut: [0, 0, 0, textured as u32],
+            ..bytemuck::Zeroable::zeroed()
+        };
+        p.bounds.write(&mut params);
+        params.center = [p.bounds.center.x, p.bounds.center.y, p.bounds.center.z, 1.0];
+        if self.plane_test == PlaneTest::Lut {
+            let b = crate::lut::bins_for(n);
+            params.kind[3] = 1;
+            params.lut[..3].copy_from_slice(&b);
+        }
+        let mut values = vec![0.0f32; view.len()];
+        let mut rgbs = vec![Vec3::ZERO; if textured { view.len() } else { 0 }];
+        let wpp = n.div_ceil(64) as usize;
+        let mut bits = vec![0u64; view.len() * wpp];
+        let mut classes: Vec<PixelClass> = (0..view.len())
+            .map(|i| {
+                if view.is_valid(i) {
+                    PixelClass::Skipped
+                } else {
+                    PixelClass::Background
+                }
+            })
+            .collect();
+        let mut stages = Vec::new();
+        let (mut occupied, mut longest, mut batches) = (0u64, 0u64, 0u64);
+        let mut tallies = [0u64; 6];
+        let groups = stats.time("frame", || {
+            group_receivers(p.bounds.center, &receivers, &pixels, per_batch, side)
+        });
+        for (chunk, chunk_px, frame) in groups {
+            batches += 1;
+            let chunk = chunk.as_slice();
+            let chunk_px = chunk_px.as_slice();
+            let mut prm = params;
+            frame.write(&mut prm);
+            check_finite(
+                bytemuck::cast_slice::<Params, f32>(std::slice::from_ref(&prm))[..32].as_ref(),
+                "light frame",
+            )
+            .map_err(device_error)?;
+            let shared = Shared {
+                casters: &p.batches,
+                samples: &p.samples,
+                radiance: &p.radiance,
+                lut: &p.lut,
+            };
+            let out = run_batch(
+                &p.gpu,
+                &p.pipes,
+                prm,
+                chunk,
+                &shared,
+                keep_regions,
+                &mut stats,
+            )
+            .map_err(device_error)?;
+            for w in out.offsets.windows(2) {
+                let len = (w[1] - w[0]) as u64;
+                occupied += (len > 0) as u64;
+                longest = longest.max(len);
+            }
+            for (k, t) in out.tallies.iter().enumerate() {
+                tallies[k] = tallies[k].saturating_add(*t);
+            }
+            for (j, &i) in chunk_px.iter().enumerate() {
+                let [r, g, b, count] = out.result[j];
+                values[i] = count / n as f32;
+                if textured {
+                    rgbs[i] = Vec3::new(r, g, b) / n as f32;
+                }
+                let vis = &out.visible[j * words as usize..(j + 1) * words as usize];
+                for (w, v) in vis.iter().enumerate() {
+                    bits[i * wpp + w / 2] |= (*v as u64) << (32 * (w % 2));
+                }
+                classes[i] = if count as u32 == n {
+                    PixelClass::Lit
+                } else if count == 0.0 {
+                    PixelClass::Umbra
+                } else {
+                    PixelClass::Penumbra
+                };
+            }
+            if keep_regions {
+                stages.push((frame, out.regions, out.offsets));
+            }
+        }
+        let mut vis = if textured {
+            let mut v = VisibilityImage::rgb_buffer(view);
+            v.rgbs_mut().copy_from_slice(&rgbs);
+            v
+        } else {
+            let mut v = VisibilityImage::scalar(view);
+            v.scalars_mut().copy_from_slice(&values);
+            v
+        };
+        vis.set_classes(classes)?;
+        vis.set_per_sample(PerSampleVisibility::Bits {
+            samples: n,
+            words: bits,
+        })?;
+        vis.validate()?;
+        stats.add("receivers-listed", receivers.len() as u64);
+        stats.add("receivers-facing-away", facing_away);
+        stats.add("receiver-batches", batches);
+        stats.add("caster-batches", p.batches.len() as u64);
+        stats.add("lists-occupied", occupied);
+        stats.add("list-length-max", longest);
+        stats.add("map-side", side as u64);
+        for (k, name) in TALLIES.iter().enumerate() {
+            stats.add(name, tallies[k]);
+        }
+        Ok((
+            Estimate {
+                visibility: vis,
+                stats,
+            },
+            receivers,
+            stages,
+        ))
+    }
+}
+
+impl ShadowTechnique for Afsm {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn capabilities(&self) -> Capabilities {
+        Capabilities {
+            lights: vec![
+                LightKind::Rectangle,
+                LightKind::Disk,
+                LightKind::Polygon,
+                LightKind::Sphere,
+                LightKind::Point,
+            ],
+            semi_opaque: false,
+            textured_lights: true,
+            needs_closed_meshes: false,
+            sample_based: !self.hard,
+            processor: Processor::Gpu,
+        }
+    }
+
+    fn parameters(&self) -> serde_json::Value {
+        json!({
+            "samples": self.samples,
+            "strategy": format!("{:?}", self.strategy),
+            "seed": self.seed,
+            "frame": self.frame,
+            "hard": self.hard,
+            "plane_test": format!("{:?}", self.plane_test),
+            "lut_bins": (self.plane_test == PlaneTest::Lut).then(|| crate::lut::bins_for(self.samples)),
+            "adapter": self.adapter(),
+        })
+    }
+
+    fn light_sampler(&self) -> Option<&LightSampler> {
+        (!self.hard).then_some(&self.sampler)
+    }
+
+    fn prepare(&mut self, scene: SceneRef, light: Light) -> Result<Stats, TechniqueError> {
+        self.capabilities()
+            .check(scene.as_ref(), light.as_ref())
+            .map_err(|reason| TechniqueError::Unsupported {
+                technique: self.name.clone(),
+                reason,
+            })?;
+        let mut stats = Stats::default();
+        let built = stats.time("prepare", || self.build(scene, light));
+        self.prepared = Some(match built {
+            Ok(p) => p,
+            Err(TechniqueError::Device(e)) if !gpu_required() && e.contains("no GPU adapter") => {
+                eprintln!(
+                    "{}: {e}; reported as unsupported (set {}=1 to make it a failure)",
+                    self.name,
+                    shadow_core::gpu::REQUIRE_GPU_ENV
+                );
+                return Err(TechniqueError::Unsupported {
+                    technique: self.name.clone(),
+                    reason: e,
+                });
+            }
+            Err(e) => return Err(e),
+        });
+        Ok(stats)
+    }
+
+    fn estimate(&mut self, view: &ViewSamples) -> Result<Estimate, TechniqueError> {
+        self.run(view, false).map(|(e, _, _)| e)
+    }
+}
