@@ -222,8 +222,7 @@ fn main(@builtin(local_invocation_id) l: vec3<u32>, @builtin(workgroup_id) w: ve
             }
         }
     }
-    // Tallies go straight to the global counters (no workgroup barrier: llvmpipe runs
-    // barrier-using shaders as coroutines, which mis-executed this kernel's long loops).
+    // Tallies go straight to the 64-bit global counters (low word, carry into the high word).
     add64(0u, visited);
     add64(1u, outcome[1] + outcome[2] + outcome[3]);
     add64(2u, outcome[1]);
