@@ -12,7 +12,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::frame::MapFrame;
-use crate::params::{Caster, KIND_DISK, KIND_POINT, KIND_SPHERE, LightBounds};
+use crate::params::{Caster, KIND_DISK, KIND_POINT, KIND_SPHERE, LightBounds, Region};
 
 /// The influence region of one caster.
 #[derive(Debug, Clone, PartialEq)]
@@ -134,6 +134,50 @@ pub fn influence(caster: &Caster, b: &LightBounds, frame: &MapFrame) -> Influenc
         return Influence::Culled;
     }
     Influence::Hull(convex_hull(pts))
+}
+
+/// Conservative rasterisation (section 3.2) as `tiling.wgsl` does it: texel `(tx, ty)` of the
+/// region's box overlaps a read-back region's hull (separating axes of the hull's edges, with
+/// the shader's 1e-3 texel margin). Regions flagged whole-map or degenerate overlap every
+/// texel of their box.
+pub fn texel_overlaps(region: &Region, tx: i32, ty: i32) -> bool {
+    let [h, flag, _, _] = region.info;
+    if flag != 0 || h < 3 {
+        return true;
+    }
+    let h = h as usize;
+    let lo = Vec2::new(tx as f32, ty as f32) - Vec2::splat(1e-3);
+    let hi = lo + Vec2::splat(1.0 + 2e-3);
+    (0..h).all(|k| {
+        let a = Vec2::from(region.pts[k]);
+        let e = Vec2::from(region.pts[(k + 1) % h]) - a;
+        let n = Vec2::new(-e.y, e.x);
+        let corner = Vec2::new(
+            if n.x > 0.0 { hi.x } else { lo.x },
+            if n.y > 0.0 { hi.y } else { lo.y },
+        );
+        n.dot(corner - a) >= 0.0
+    })
+}
+
+/// The occlusion work of read-back regions over read-back list offsets (`side^2 + 1`): the
+/// texels with a list that overlap a region, and the (caster, view sample) pairs they hold,
+/// as the `tile_pairs` pass tallies them.
+pub fn occlusion_work(regions: &[Region], offsets: &[u32], side: u32) -> (u64, u64) {
+    let (mut texels, mut pairs) = (0u64, 0u64);
+    for r in regions {
+        for ty in r.bbox[1]..=r.bbox[3] {
+            for tx in r.bbox[0]..=r.bbox[2] {
+                let t = (ty as u32 * side + tx as u32) as usize;
+                let len = (offsets[t + 1] - offsets[t]) as u64;
+                if len > 0 && texel_overlaps(r, tx, ty) {
+                    texels += 1;
+                    pairs += len;
+                }
+            }
+        }
+    }
+    (texels, pairs)
 }
 
 #[cfg(test)]

@@ -42,6 +42,8 @@ pub struct Params {
     pub kind: [u32; 4],
     /// LUT bins (theta, phi, delta), textured flag.
     pub lut: [u32; 4],
+    /// Occlusion work of one caster range: first caster, caster count, tiles, chunks.
+    pub work: [u32; 4],
     /// Points bounding the light.
     pub outline: [[f32; 4]; 8],
 }

@@ -3,9 +3,17 @@
 //! 1. `count` (section 3.1): project each view sample, atomically take a slot in its texel;
 //! 2. `scan_block` / `scan_add`: the running sum of list lengths gives list offsets;
 //! 3. `scatter`: each view sample's index goes to its list's offset plus its slot;
-//! 4. per batch of caster triangles, `influence` (section 4.1) then `occlude` (sections 3.2,
-//!    3.3, 4.2, 4.3);
+//! 4. per batch of caster triangles, `influence` (section 4.1); then, per range of casters,
+//!    `tiles` (8 x 8 texel tiles per region, numbered by a running sum), `tile_pairs` (pairs
+//!    per tile from the overlapping texels' lists, in chunks of 64, numbered by a running sum)
+//!    and `occlude` (sections 3.2, 3.3, 4.2, 4.3: one workgroup per chunk, one pair per
+//!    invocation);
 //! 5. `resolve`: horizon test, visible bits, counts and radiance sums.
+//!
+//! Every invocation does bounded work, however large an influence region or long a list: the
+//! work is spread evenly over the GPU (the load balancing the paper's one-triangle-at-a-time
+//! rasterisation lacks), and software rasterisers that end an invocation's loops after 65535
+//! iterations in all (llvmpipe) still compute every pair.
 //!
 //! Each phase is submitted on its own and waited for, so [`Stats`] holds per-phase GPU times
 //! (submission to completion).
@@ -17,18 +25,40 @@ use shadow_core::technique::Stats;
 
 use crate::params::{Params, Receiver, Region};
 
-/// The shared WGSL prefix.
+/// The shared WGSL prefix (structures, projection, light support function, tiles).
 pub const COMMON: &str = include_str!("shaders/common.wgsl");
+/// 64-bit tallies (`add64`), for the passes that declare `stats`.
+pub const TALLY: &str = include_str!("shaders/tally.wgsl");
+/// Tiles of influence regions (bindings 1 to 3 and their helpers).
+pub const TILING: &str = include_str!("shaders/tiling.wgsl");
 
-/// Every pass: name, source, and whether it is prefixed with [`COMMON`].
-pub const MODULES: [(&str, &str, bool); 7] = [
-    ("count", include_str!("shaders/count.wgsl"), true),
-    ("scan_block", include_str!("shaders/scan_block.wgsl"), false),
-    ("scan_add", include_str!("shaders/scan_add.wgsl"), false),
-    ("scatter", include_str!("shaders/scatter.wgsl"), true),
-    ("influence", include_str!("shaders/influence.wgsl"), true),
-    ("occlude", include_str!("shaders/occlude.wgsl"), true),
-    ("resolve", include_str!("shaders/resolve.wgsl"), true),
+/// Every pass: name, source, and the prefixes it is compiled with, in order.
+pub const MODULES: [(&str, &str, &[&str]); 9] = [
+    ("count", include_str!("shaders/count.wgsl"), &[COMMON]),
+    ("scan_block", include_str!("shaders/scan_block.wgsl"), &[]),
+    ("scan_add", include_str!("shaders/scan_add.wgsl"), &[]),
+    ("scatter", include_str!("shaders/scatter.wgsl"), &[COMMON]),
+    (
+        "influence",
+        include_str!("shaders/influence.wgsl"),
+        &[COMMON],
+    ),
+    (
+        "tiles",
+        include_str!("shaders/tiles.wgsl"),
+        &[COMMON, TALLY],
+    ),
+    (
+        "tile_pairs",
+        include_str!("shaders/tile_pairs.wgsl"),
+        &[COMMON, TALLY, TILING],
+    ),
+    (
+        "occlude",
+        include_str!("shaders/occlude.wgsl"),
+        &[COMMON, TALLY, TILING],
+    ),
+    ("resolve", include_str!("shaders/resolve.wgsl"), &[COMMON]),
 ];
 
 /// The full WGSL source of pass `name`.
@@ -36,15 +66,14 @@ pub const MODULES: [(&str, &str, bool); 7] = [
 /// # Panics
 /// For a name not in [`MODULES`] (a programming error).
 pub fn source(name: &str) -> String {
-    let (_, src, common) = MODULES
+    let (_, src, prefixes) = MODULES
         .iter()
         .find(|(n, _, _)| *n == name)
         .expect("known module");
-    if *common {
-        format!("{COMMON}\n{src}")
-    } else {
-        (*src).to_string()
-    }
+    let mut out = prefixes.join("\n");
+    out.push('\n');
+    out.push_str(src);
+    out
 }
 
 /// The compiled pipelines.
@@ -55,6 +84,8 @@ pub struct Pipelines {
     scan_add: wgpu::ComputePipeline,
     scatter: wgpu::ComputePipeline,
     influence: wgpu::ComputePipeline,
+    tiles: wgpu::ComputePipeline,
+    tile_pairs: wgpu::ComputePipeline,
     occlude: wgpu::ComputePipeline,
     resolve: wgpu::ComputePipeline,
 }
@@ -72,6 +103,8 @@ impl Pipelines {
             scan_add: p("scan_add")?,
             scatter: p("scatter")?,
             influence: p("influence")?,
+            tiles: p("tiles")?,
+            tile_pairs: p("tile_pairs")?,
             occlude: p("occlude")?,
             resolve: p("resolve")?,
         })
@@ -139,6 +172,147 @@ pub struct Shared<'a> {
     pub radiance: &'a wgpu::Buffer,
     /// The plane table (a dummy in exact mode).
     pub lut: &'a wgpu::Buffer,
+    /// The largest buffer the technique may bind (the device's limit or a smaller cap).
+    pub limit: u64,
+}
+
+/// 64-bit tally slots beyond [`TALLIES`]: tiles and chunks of the current caster range.
+const TILE_SLOT: usize = 6;
+const CHUNK_SLOT: usize = 7;
+/// Tallies buffer length in u32 words (eight 64-bit slots).
+const TALLY_WORDS: usize = 16;
+
+/// The buffers one batch of view samples shares between its caster ranges.
+struct Occlusion<'a> {
+    gpu: &'a GpuContext,
+    pipes: &'a Pipelines,
+    shared: &'a Shared<'a>,
+    regions: &'a wgpu::Buffer,
+    receivers: &'a wgpu::Buffer,
+    offsets: &'a wgpu::Buffer,
+    lists: &'a wgpu::Buffer,
+    masks: &'a wgpu::Buffer,
+    tallies: &'a wgpu::Buffer,
+}
+
+impl Occlusion<'_> {
+    /// Reads the 64-bit tally `slot`.
+    fn tally(&self, slot: usize) -> Result<u64, GpuError> {
+        let t: Vec<u32> = self.gpu.read(self.tallies, TALLY_WORDS)?;
+        Ok(t[2 * slot] as u64 | (t[2 * slot + 1] as u64) << 32)
+    }
+
+    /// Tiles, pairs and occlusion for casters `base..base + count` of `batch`. A range whose
+    /// tile numbering would not fit a buffer is split in two.
+    fn range(
+        &self,
+        params: Params,
+        batch: &CasterBatch,
+        base: u32,
+        count: u32,
+        stats: &mut Stats,
+    ) -> Result<(), GpuError> {
+        let gpu = self.gpu;
+        let pipes = self.pipes;
+        let mut p = params;
+        p.work = [base, count, 0, 0];
+        let mut keep = Vec::new();
+        let tile_counts = gpu.storage_zeroed("tile counts", (count as u64 + 1) * 4)?;
+        let tiles = stats.time("gpu-tiles", || {
+            let uni = gpu.uniform("params", &p);
+            let mut enc = gpu.encoder();
+            enc.clear_buffer(self.tallies, 4 * 2 * TILE_SLOT as u64, Some(16));
+            let b = gpu.bind(
+                &pipes.tiles,
+                &[&uni, self.regions, &tile_counts, self.tallies],
+            );
+            gpu.dispatch(&mut enc, &pipes.tiles, &b, (count as u64).div_ceil(64))?;
+            scan(gpu, pipes, &mut enc, &tile_counts, count + 1, &mut keep)?;
+            gpu.submit(enc)?;
+            self.tally(TILE_SLOT)
+        })?;
+        if tiles == 0 {
+            return Ok(());
+        }
+        let max_tiles = (self.shared.limit / 4)
+            .saturating_sub(1)
+            .min(u32::MAX as u64 - 1);
+        if tiles > max_tiles {
+            // One caster covers at most (side / 8)^2 tiles, which the map's own buffer bounds.
+            let half = count / 2;
+            if half == 0 {
+                return Err(GpuError::TooLarge {
+                    what: "tile numbering of one caster".into(),
+                    needed: (tiles + 1) * 4,
+                    limit: self.shared.limit,
+                });
+            }
+            self.range(params, batch, base, half, stats)?;
+            return self.range(params, batch, base + half, count - half, stats);
+        }
+        p.work[2] = tiles as u32;
+        let chunk_counts = gpu.storage_zeroed("chunk counts", (tiles + 1) * 4)?;
+        let chunks = stats.time("gpu-tiles", || {
+            let uni = gpu.uniform("params", &p);
+            let mut enc = gpu.encoder();
+            let b = gpu.bind(
+                &pipes.tile_pairs,
+                &[
+                    &uni,
+                    self.regions,
+                    &tile_counts,
+                    self.offsets,
+                    &chunk_counts,
+                    self.tallies,
+                ],
+            );
+            gpu.dispatch(&mut enc, &pipes.tile_pairs, &b, tiles.div_ceil(64))?;
+            scan(
+                gpu,
+                pipes,
+                &mut enc,
+                &chunk_counts,
+                tiles as u32 + 1,
+                &mut keep,
+            )?;
+            gpu.submit(enc)?;
+            self.tally(CHUNK_SLOT)
+        })?;
+        if chunks >= u32::MAX as u64 {
+            return Err(GpuError::TooLarge {
+                what: format!("occlusion work of {chunks} chunks of 64 pairs in one caster range"),
+                needed: chunks,
+                limit: u32::MAX as u64,
+            });
+        }
+        if chunks == 0 {
+            return Ok(());
+        }
+        p.work[3] = chunks as u32;
+        stats.time("gpu-occlude", || {
+            let uni = gpu.uniform("params", &p);
+            let mut enc = gpu.encoder();
+            let b = gpu.bind(
+                &pipes.occlude,
+                &[
+                    &uni,
+                    self.regions,
+                    &tile_counts,
+                    self.offsets,
+                    &chunk_counts,
+                    &batch.buffer,
+                    self.receivers,
+                    self.lists,
+                    self.shared.samples,
+                    self.masks,
+                    self.tallies,
+                    self.shared.lut,
+                ],
+            );
+            gpu.dispatch(&mut enc, &pipes.occlude, &b, chunks)?;
+            gpu.submit(enc)
+        })
+    }
 }
 
 /// Occlusion-pass tallies, in the order the shader keeps them.
@@ -194,7 +368,7 @@ pub fn run_batch(
             gpu.storage_zeroed("lists", n as u64 * 4)?,
             gpu.storage_zeroed("masks", n as u64 * words as u64 * 4)?,
             gpu.storage_zeroed("result", n as u64 * 16)?,
-            gpu.storage_zeroed("tallies", 12 * 4)?,
+            gpu.storage_zeroed("tallies", TALLY_WORDS as u64 * 4)?,
         ))
     })?;
     let uni = gpu.uniform("params", &params);
@@ -216,6 +390,17 @@ pub fn run_batch(
         largest as u64 * std::mem::size_of::<Region>() as u64,
     )?;
     let mut last_regions = Vec::new();
+    let occ = Occlusion {
+        gpu,
+        pipes,
+        shared,
+        regions: &regions,
+        receivers: &rbuf,
+        offsets: &counts,
+        lists: &lists,
+        masks: &masks,
+        tallies: &tallies,
+    };
     for batch in shared.casters {
         let mut p = params;
         p.kind[0] = batch.len;
@@ -234,26 +419,7 @@ pub fn run_batch(
         if keep_regions {
             last_regions = gpu.read::<Region>(&regions, batch.len as usize)?;
         }
-        stats.time("gpu-occlude", || {
-            let mut enc = gpu.encoder();
-            let b = gpu.bind(
-                &pipes.occlude,
-                &[
-                    &uni,
-                    &batch.buffer,
-                    &regions,
-                    &rbuf,
-                    &counts,
-                    &lists,
-                    shared.samples,
-                    &masks,
-                    &tallies,
-                    shared.lut,
-                ],
-            );
-            gpu.dispatch(&mut enc, &pipes.occlude, &b, batch.len as u64)?;
-            gpu.submit(enc)
-        })?;
+        occ.range(p, batch, 0, batch.len, stats)?;
     }
     stats.time("gpu-resolve", || {
         let mut enc = gpu.encoder();
@@ -272,7 +438,7 @@ pub fn run_batch(
         gpu.submit(enc)
     })?;
     stats.time("gpu-readback", || {
-        let t: Vec<u32> = gpu.read(&tallies, 12)?;
+        let t: Vec<u32> = gpu.read(&tallies, TALLY_WORDS)?;
         let mut tallies = [0u64; 6];
         for (k, v) in tallies.iter_mut().enumerate() {
             *v = t[2 * k] as u64 | (t[2 * k + 1] as u64) << 32;

@@ -473,6 +473,7 @@ impl Afsm {
                 samples: &p.samples,
                 radiance: &p.radiance,
                 lut: &p.lut,
+                limit,
             };
             let out = run_batch(
                 &p.gpu,

@@ -21,6 +21,8 @@ struct Params {
     kind: vec4<u32>,
     // LUT bins in theta, phi, delta; 1 when the light is textured.
     lut: vec4<u32>,
+    // The occlusion work of one range of casters: first caster, caster count, tiles, chunks.
+    work: vec4<u32>,
     // Up to 8 points bounding the light (rectangle corners, polygon outline or its box).
     outline: array<vec4<f32>, 8>,
 }
@@ -105,4 +107,15 @@ fn light_range(m: vec3<f32>) -> vec2<f32> {
             return vec2<f32>(lo, hi);
         }
     }
+}
+
+// Influence regions are covered by tiles of TILE x TILE texels (one workgroup's worth).
+const TILE: i32 = 8;
+
+// Tiles across and down a texel box (zero for an empty box).
+fn tiles_across(bbox: vec4<i32>) -> vec2<u32> {
+    if bbox.z < bbox.x || bbox.w < bbox.y {
+        return vec2<u32>(0u);
+    }
+    return vec2<u32>(u32((bbox.z - bbox.x) / TILE + 1), u32((bbox.w - bbox.y) / TILE + 1));
 }

@@ -1,6 +1,7 @@
-// Sections 3.2, 3.3 and 4.2: one workgroup per caster triangle walks the texels of its
-// influence region (conservative rasterisation: a texel is visited when its square overlaps
-// the hull), skips empty lists, and tests every listed view sample against the triangle.
+// Sections 3.2, 3.3 and 4.2: one workgroup per chunk of 64 (caster, view sample) pairs of one
+// tile (see `tiling.wgsl`): the tile's texels that overlap the caster's influence region
+// (conservative rasterisation) give their list lengths, a workgroup prefix sum finds each
+// invocation's pair, and every invocation tests its listed view sample against the triangle.
 //
 // A light sample y is hidden from view sample o by the triangle when y lies inside the three
 // planes through o and each edge, and beyond the triangle's supporting plane. For closed
@@ -18,49 +19,20 @@
 // masks of the planes are ANDed. Results combine across triangles with atomic OR.
 
 @group(0) @binding(0) var<uniform> P: Params;
-@group(0) @binding(1) var<storage, read> casters: array<Caster>;
-@group(0) @binding(2) var<storage, read> regions: array<Region>;
-@group(0) @binding(3) var<storage, read> receivers: array<Receiver>;
-@group(0) @binding(4) var<storage, read> offsets: array<u32>;
-@group(0) @binding(5) var<storage, read> lists: array<u32>;
-@group(0) @binding(6) var<storage, read> samples: array<vec4<f32>>;
-@group(0) @binding(7) var<storage, read_write> masks: array<atomic<u32>>;
-@group(0) @binding(8) var<storage, read_write> stats: array<atomic<u32>>;
-@group(0) @binding(9) var<storage, read> lut: array<u32>;
+@group(0) @binding(4) var<storage, read> chunk_offsets: array<u32>;
+@group(0) @binding(5) var<storage, read> casters: array<Caster>;
+@group(0) @binding(6) var<storage, read> receivers: array<Receiver>;
+@group(0) @binding(7) var<storage, read> lists: array<u32>;
+@group(0) @binding(8) var<storage, read> samples: array<vec4<f32>>;
+@group(0) @binding(9) var<storage, read_write> masks: array<atomic<u32>>;
+@group(0) @binding(10) var<storage, read_write> stats: array<atomic<u32>>;
+@group(0) @binding(11) var<storage, read> lut: array<u32>;
 
-fn add64(slot: u32, v: u32) {
-    if v == 0u {
-        return;
-    }
-    let old = atomicAdd(&stats[2u * slot], v);
-    if old + v < old {
-        atomicAdd(&stats[2u * slot + 1u], 1u);
-    }
-}
-
-fn texel_overlaps(t: u32, tx: i32, ty: i32) -> bool {
-    let info = regions[t].info;
-    if info.y != 0u || info.x < 3u {
-        return true;
-    }
-    // Separating axes: the hull's edges (the box was tested by the loop bounds).
-    let lo = vec2<f32>(f32(tx), f32(ty)) - vec2<f32>(1e-3);
-    let hi = lo + vec2<f32>(1.0 + 2e-3);
-    let h = info.x;
-    for (var k = 0u; k < h; k++) {
-        let a = regions[t].pts[k];
-        let b = regions[t].pts[(k + 1u) % h];
-        let e = b - a;
-        // Inward normal of a counter-clockwise hull is (-e.y, e.x); the texel is outside when
-        // its corner farthest along that normal is still outside.
-        let nrm = vec2<f32>(-e.y, e.x);
-        let corner = vec2<f32>(select(lo.x, hi.x, nrm.x > 0.0), select(lo.y, hi.y, nrm.y > 0.0));
-        if dot(nrm, corner - a) < 0.0 {
-            return false;
-        }
-    }
-    return true;
-}
+// The tile's list lengths (then their inclusive running sum), texel indices, and the pair
+// outcomes of the workgroup.
+var<workgroup> prefix: array<u32, 64>;
+var<workgroup> texels: array<u32, 64>;
+var<workgroup> outcomes: array<atomic<u32>, 4>;
 
 // LUT cell of the oriented plane {y : dot(m, y - base) >= 0}.
 fn lut_cell(m: vec3<f32>, base: vec3<f32>) -> u32 {
@@ -115,25 +87,20 @@ fn occlude_pair(t: u32, i: u32) -> u32 {
     bs[3] = dot(ms[3], o);
     var live: array<u32, 4>;
     var na = 0u;
+    var empty = false;
     for (var p = 0u; p < 4u; p++) {
         let rg = light_range(ms[p]) - bs[p];
-        if p == 0u {
-            if rg.y <= 0.0 {
-                return 1u;
-            }
-            if rg.x > 0.0 {
-                continue;
-            }
-        } else {
-            if rg.y < 0.0 {
-                return 1u;
-            }
-            if rg.x >= 0.0 {
-                continue;
-            }
+        // Outside: the whole light is behind the plane; inside: the whole light in front.
+        let outside = select(rg.y < 0.0, rg.y <= 0.0, p == 0u);
+        let inside = select(rg.x >= 0.0, rg.x > 0.0, p == 0u);
+        empty = empty || outside;
+        if !inside {
+            live[na] = p;
+            na++;
         }
-        live[na] = p;
-        na++;
+    }
+    if empty {
+        return 1u;
     }
     let n_samples = P.dims.z;
     let words = P.dims.w;
@@ -175,10 +142,7 @@ fn occlude_pair(t: u32, i: u32) -> u32 {
             for (var q = 0u; q < na; q++) {
                 let p = live[q];
                 let f = dot(ms[p], y) - bs[p];
-                if (p == 0u && f <= 0.0) || (p != 0u && f < 0.0) {
-                    inside = false;
-                    break;
-                }
+                inside = inside && select(f >= 0.0, f > 0.0, p == 0u);
             }
             if inside {
                 bits |= 1u << (kk - k0);
@@ -192,41 +156,55 @@ fn occlude_pair(t: u32, i: u32) -> u32 {
 }
 
 @compute @workgroup_size(64)
-fn main(@builtin(local_invocation_id) l: vec3<u32>, @builtin(workgroup_id) w: vec3<u32>,
+fn main(@builtin(local_invocation_index) li: u32, @builtin(workgroup_id) w: vec3<u32>,
         @builtin(num_workgroups) nw: vec3<u32>) {
-    let t = w.y * nw.x + w.x;
-    if t >= P.kind.x {
+    let c = w.y * nw.x + w.x;
+    if c >= P.work.w {
         return;
     }
-    let bbox = regions[t].bbox;
-    let bw = bbox.z - bbox.x + 1;
-    let bh = bbox.w - bbox.y + 1;
-    // Tallies: texels visited, pairs, then by outcome (own, empty, full, per-sample).
-    var visited = 0u;
-    var outcome = array<u32, 4>(0u, 0u, 0u, 0u);
-    if bw > 0 && bh > 0 {
-        let side = P.dims.x;
-        let area = u32(bw) * u32(bh);
-        for (var k = l.x; k < area; k += 64u) {
-            let tx = bbox.x + i32(k % u32(bw));
-            let ty = bbox.y + i32(k / u32(bw));
-            let texel = u32(ty) * side + u32(tx);
-            let start = offsets[texel];
-            let end = offsets[texel + 1u];
-            if start == end || !texel_overlaps(t, tx, ty) {
-                continue;
-            }
-            visited++;
-            for (var e = start; e < end; e++) {
-                outcome[occlude_pair(t, lists[e])]++;
-            }
+    // The chunk's tile: the last tile whose first chunk is at or before c.
+    var lo = 0u;
+    var hi = P.work.z;
+    while hi - lo > 1u {
+        let mid = (lo + hi) / 2u;
+        if chunk_offsets[mid] <= c {
+            lo = mid;
+        } else {
+            hi = mid;
         }
     }
-    // Tallies go straight to the 64-bit global counters (low word, carry into the high word).
-    add64(0u, visited);
-    add64(1u, outcome[1] + outcome[2] + outcome[3]);
-    add64(2u, outcome[1]);
-    add64(3u, outcome[2]);
-    add64(4u, outcome[3]);
-    add64(5u, outcome[0]);
+    let tl = tile_of(lo);
+    let tt = tile_texel(tl, li);
+    texels[li] = tt.x;
+    prefix[li] = tt.y;
+    workgroupBarrier();
+    for (var s = 1u; s < 64u; s <<= 1u) {
+        let add = select(0u, prefix[li - s], li >= s);
+        workgroupBarrier();
+        prefix[li] += add;
+        workgroupBarrier();
+    }
+    // This invocation's pair: entry e of the tile, in texel k's list.
+    let e = (c - chunk_offsets[lo]) * 64u + li;
+    if e < prefix[63] {
+        var k = 0u;
+        var step = 32u;
+        while step > 0u {
+            if prefix[k + step - 1u] <= e {
+                k += step;
+            }
+            step >>= 1u;
+        }
+        let before = select(0u, prefix[max(k, 1u) - 1u], k > 0u);
+        let i = lists[offsets[texels[k]] + e - before];
+        atomicAdd(&outcomes[occlude_pair(tl.caster, i)], 1u);
+    }
+    workgroupBarrier();
+    // Tallies by outcome (empty, full, per-sample, own triangle), once per workgroup.
+    if li == 0u {
+        add64(2u, atomicLoad(&outcomes[1]));
+        add64(3u, atomicLoad(&outcomes[2]));
+        add64(4u, atomicLoad(&outcomes[3]));
+        add64(5u, atomicLoad(&outcomes[0]));
+    }
 }

@@ -1,0 +1,80 @@
+// Load balancing of the occlusion work (section 4.3's restricted computations, spread evenly):
+// each caster's influence region is covered by 8 x 8 texel tiles, tiles hold the pairs of the
+// listed view samples in their texels that overlap the region, and chunks of 64 pairs are the
+// unit of work. Every invocation thus does a bounded amount of work however large a region or
+// long a list is. (Software rasterisers such as llvmpipe also end every loop of an invocation
+// after 65535 iterations in all, so unbounded per-invocation loops would silently drop work.)
+//
+// Tiles are numbered per range of casters by the running sum of their counts (`tile_offsets`).
+
+@group(0) @binding(1) var<storage, read> regions: array<Region>;
+@group(0) @binding(2) var<storage, read> tile_offsets: array<u32>;
+@group(0) @binding(3) var<storage, read> offsets: array<u32>;
+
+struct Tile {
+    // Caster index in the batch.
+    caster: u32,
+    // First texel of the tile, and the last texel of the region's box.
+    origin: vec2<i32>,
+    last: vec2<i32>,
+}
+
+// Tile `u` of the current range: the last caster whose first tile is at or before `u`.
+fn tile_of(u: u32) -> Tile {
+    var lo = 0u;
+    var hi = P.work.y;
+    while hi - lo > 1u {
+        let mid = (lo + hi) / 2u;
+        if tile_offsets[mid] <= u {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let t = P.work.x + lo;
+    let bbox = regions[t].bbox;
+    let across = tiles_across(bbox).x;
+    let j = u - tile_offsets[lo];
+    let origin = bbox.xy + TILE * vec2<i32>(i32(j % across), i32(j / across));
+    return Tile(t, origin, bbox.zw);
+}
+
+// Conservative rasterisation (section 3.2): texel (tx, ty) overlaps the hull of caster t.
+fn texel_overlaps(t: u32, tx: i32, ty: i32) -> bool {
+    let info = regions[t].info;
+    if info.y != 0u || info.x < 3u {
+        return true;
+    }
+    // Separating axes: the hull's edges (the box is tested by the tiling).
+    let lo = vec2<f32>(f32(tx), f32(ty)) - vec2<f32>(1e-3);
+    let hi = lo + vec2<f32>(1.0 + 2e-3);
+    let h = info.x;
+    var inside = true;
+    for (var k = 0u; k < h; k++) {
+        let a = regions[t].pts[k];
+        let b = regions[t].pts[(k + 1u) % h];
+        let e = b - a;
+        // Inward normal of a counter-clockwise hull is (-e.y, e.x); the texel is outside when
+        // its corner farthest along that normal is still outside.
+        let nrm = vec2<f32>(-e.y, e.x);
+        let corner = vec2<f32>(select(lo.x, hi.x, nrm.x > 0.0), select(lo.y, hi.y, nrm.y > 0.0));
+        inside = inside && dot(nrm, corner - a) >= 0.0;
+    }
+    return inside;
+}
+
+// Texel `k` (0..64, row-major) of a tile: its index and the length of its list, 0 when it lies
+// outside the region's box or hull (empty lists are skipped, section 4.3).
+fn tile_texel(tl: Tile, k: u32) -> vec2<u32> {
+    let tx = tl.origin.x + i32(k % u32(TILE));
+    let ty = tl.origin.y + i32(k / u32(TILE));
+    if tx > tl.last.x || ty > tl.last.y {
+        return vec2<u32>(0u);
+    }
+    let texel = u32(ty) * P.dims.x + u32(tx);
+    let len = offsets[texel + 1u] - offsets[texel];
+    if len == 0u || !texel_overlaps(tl.caster, tx, ty) {
+        return vec2<u32>(texel, 0u);
+    }
+    return vec2<u32>(texel, len);
+}
