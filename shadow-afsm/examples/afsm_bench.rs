@@ -1,6 +1,8 @@
 //! Time against error of AFSM beside the reference on the same samples, per-phase GPU times
 //! and the list statistics of the paper's Fig. 9 inlay, on the adapter the environment selects:
-//! `cargo run --release -p shadow-afsm --example afsm_bench -- [scene] [width] [height] [N]`.
+//! `cargo run --release -p shadow-afsm --example afsm_bench -- [scene] [width] [height] [N]
+//! [exact|lut|stencil]`: exact plane tests on 4x4 interleaved sets (default), the plane lookup
+//! table of section 4.2 (one correlated set), or exact tests with the silhouette stencil.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -19,7 +21,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let setup = shadow_core::scenes::builtin(scene)?;
     let light = Arc::clone(&setup.lights[0]);
     let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), w, h)?;
-    let mut afsm = Afsm::new(n, SamplingStrategy::Interleaved { tile: 4 }, 1)?;
+    let mode = args.get(5).map_or("exact", String::as_str);
+    let interleaved = SamplingStrategy::Interleaved { tile: 4 };
+    let mut afsm = match mode {
+        "exact" => Afsm::new(n, interleaved, 1)?,
+        "stencil" => Afsm::new(n, interleaved, 1)?.with_silhouette_stencil(),
+        "lut" => Afsm::new(n, SamplingStrategy::Correlated, 1)?.with_lut()?,
+        other => return Err(format!("unknown mode `{other}`: exact, lut or stencil").into()),
+    };
     afsm.prepare(setup.scene.clone(), Arc::clone(&light))?;
     afsm.estimate(&view)?; // warm-up
     let t0 = Instant::now();
@@ -33,7 +42,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let m = compare(&est.visibility, &re.visibility)?;
     println!("adapter: {}", afsm.adapter().unwrap_or_default());
     println!(
-        "{scene} {w}x{h} N={n}: afsm {t_afsm:.3} s, reference (same samples, CPU) {t_ref:.3} s, ratio {:.2}",
+        "{scene} {w}x{h} N={n} {mode}: afsm {t_afsm:.3} s, reference (same samples, CPU) {t_ref:.3} s, ratio {:.2}",
         t_ref / t_afsm
     );
     println!(
@@ -59,7 +68,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "pairs-empty",
         "pairs-full",
         "pairs-per-sample",
+        "pairs-one-sample",
         "texels-visited",
+        "silhouette-edges",
     ] {
         println!("  {k} {}", est.stats.counter(k));
     }

@@ -44,6 +44,9 @@ pub struct Params {
     pub lut: [u32; 4],
     /// Occlusion work of one caster range: first caster, caster count, tiles, chunks.
     pub work: [u32; 4],
+    /// x = 1 when the silhouette stencil restricts per-sample work; y = 1 when semi-opaque
+    /// casters accumulate per-sample optical depths.
+    pub options: [u32; 4],
     /// Points bounding the light.
     pub outline: [[f32; 4]; 8],
 }
@@ -103,12 +106,20 @@ pub struct Caster {
     pub closed: u32,
     /// Vertex c.
     pub c: [f32; 3],
-    /// Padding.
-    pub pad: u32,
+    /// Optical depth of one crossing, `-ln(1 - opacity)` in units of `1 / DEPTH_SCALE`, or
+    /// [`OPAQUE`].
+    pub optical_depth: u32,
 }
 
+/// Fixed-point units per nat of optical depth (`2^20`: a crossing's transmittance is kept to
+/// a relative 5e-7).
+pub const DEPTH_SCALE: f32 = 1_048_576.0;
+
+/// `optical_depth` of an opaque caster: its occluded samples go to the bitmask.
+pub const OPAQUE: u32 = u32::MAX;
+
 impl Caster {
-    /// Packs a triangle.
+    /// Packs an opaque triangle.
     pub fn new(v: [Vec3; 3], id: u32, closed: bool) -> Self {
         Self {
             a: v[0].to_array(),
@@ -116,8 +127,21 @@ impl Caster {
             b: v[1].to_array(),
             closed: closed as u32,
             c: v[2].to_array(),
-            pad: 0,
+            optical_depth: OPAQUE,
         }
+    }
+
+    /// Gives the triangle an opacity in (0, 1): each crossing multiplies a light sample's
+    /// transmittance by `1 - opacity` (at least one fixed-point unit, so that a crossed sample
+    /// never counts as unobstructed); opacity 1 keeps it opaque. A semi-opaque triangle
+    /// counts from both sides (a segment through a closed semi-opaque mesh crosses it twice).
+    pub fn with_opacity(mut self, opacity: f32) -> Self {
+        if opacity < 1.0 {
+            let depth = -(1.0 - opacity.max(0.0)).ln() * DEPTH_SCALE;
+            self.optical_depth = (depth.round() as u32).clamp(1, OPAQUE - 1);
+            self.closed = 0;
+        }
+        self
     }
     /// The vertices.
     pub fn vertices(&self) -> [Vec3; 3] {

@@ -33,7 +33,7 @@ pub const TALLY: &str = include_str!("shaders/tally.wgsl");
 pub const TILING: &str = include_str!("shaders/tiling.wgsl");
 
 /// Every pass: name, source, and the prefixes it is compiled with, in order.
-pub const MODULES: [(&str, &str, &[&str]); 9] = [
+pub const MODULES: [(&str, &str, &[&str]); 10] = [
     ("count", include_str!("shaders/count.wgsl"), &[COMMON]),
     ("scan_block", include_str!("shaders/scan_block.wgsl"), &[]),
     ("scan_add", include_str!("shaders/scan_add.wgsl"), &[]),
@@ -57,6 +57,11 @@ pub const MODULES: [(&str, &str, &[&str]); 9] = [
         "occlude",
         include_str!("shaders/occlude.wgsl"),
         &[COMMON, TALLY, TILING],
+    ),
+    (
+        "stencil",
+        include_str!("shaders/stencil.wgsl"),
+        &[COMMON, TILING],
     ),
     ("resolve", include_str!("shaders/resolve.wgsl"), &[COMMON]),
 ];
@@ -87,6 +92,7 @@ pub struct Pipelines {
     tiles: wgpu::ComputePipeline,
     tile_pairs: wgpu::ComputePipeline,
     occlude: wgpu::ComputePipeline,
+    stencil: wgpu::ComputePipeline,
     resolve: wgpu::ComputePipeline,
 }
 
@@ -106,6 +112,7 @@ impl Pipelines {
             tiles: p("tiles")?,
             tile_pairs: p("tile_pairs")?,
             occlude: p("occlude")?,
+            stencil: p("stencil")?,
             resolve: p("resolve")?,
         })
     }
@@ -172,15 +179,29 @@ pub struct Shared<'a> {
     pub radiance: &'a wgpu::Buffer,
     /// The plane table (a dummy in exact mode).
     pub lut: &'a wgpu::Buffer,
+    /// True when some caster is semi-opaque: per-sample optical depths are kept.
+    pub semi_opaque: bool,
+    /// Potential silhouette edges as degenerate casters `(a, b, b)` (section 4.3), in batches;
+    /// empty when the stencil is off.
+    pub silhouettes: &'a [CasterBatch],
     /// The largest buffer the technique may bind (the device's limit or a smaller cap).
     pub limit: u64,
 }
 
+/// What a range of tiled regions is for.
+#[derive(Clone, Copy)]
+enum Work<'a> {
+    /// Occlusion by these casters.
+    Occlude(&'a CasterBatch),
+    /// The silhouette stencil from these edges' regions.
+    Stencil,
+}
+
 /// 64-bit tally slots beyond [`TALLIES`]: tiles and chunks of the current caster range.
-const TILE_SLOT: usize = 6;
-const CHUNK_SLOT: usize = 7;
-/// Tallies buffer length in u32 words (eight 64-bit slots).
-const TALLY_WORDS: usize = 16;
+const TILE_SLOT: usize = 7;
+const CHUNK_SLOT: usize = 8;
+/// Tallies buffer length in u32 words (nine 64-bit slots).
+const TALLY_WORDS: usize = 18;
 
 /// The buffers one batch of view samples shares between its caster ranges.
 struct Occlusion<'a> {
@@ -193,6 +214,8 @@ struct Occlusion<'a> {
     lists: &'a wgpu::Buffer,
     masks: &'a wgpu::Buffer,
     tallies: &'a wgpu::Buffer,
+    flags: &'a wgpu::Buffer,
+    depths: &'a wgpu::Buffer,
 }
 
 impl Occlusion<'_> {
@@ -202,12 +225,35 @@ impl Occlusion<'_> {
         Ok(t[2 * slot] as u64 | (t[2 * slot + 1] as u64) << 32)
     }
 
-    /// Tiles, pairs and occlusion for casters `base..base + count` of `batch`. A range whose
-    /// tile numbering would not fit a buffer is split in two.
-    fn range(
+    /// Influence regions of `batch`, then its tiled work.
+    fn batch(
         &self,
         params: Params,
         batch: &CasterBatch,
+        work: Work<'_>,
+        stats: &mut Stats,
+    ) -> Result<(), GpuError> {
+        let (gpu, pipes) = (self.gpu, self.pipes);
+        let mut p = params;
+        p.kind[0] = batch.len;
+        stats.time("gpu-influence", || {
+            let uni = gpu.uniform("params", &p);
+            let mut enc = gpu.encoder();
+            let b = gpu.bind(&pipes.influence, &[&uni, &batch.buffer, self.regions]);
+            let groups = (batch.len as u64).div_ceil(64);
+            gpu.dispatch(&mut enc, &pipes.influence, &b, groups)?;
+            gpu.submit(enc)
+        })?;
+        self.range(p, work, 0, batch.len, stats)
+    }
+
+    /// Tiles, then the stencil or the pairs and their occlusion, for casters
+    /// `base..base + count` of the current batch. A range whose tile numbering would not fit a
+    /// buffer is split in two.
+    fn range(
+        &self,
+        params: Params,
+        work: Work<'_>,
         base: u32,
         count: u32,
         stats: &mut Stats,
@@ -247,10 +293,25 @@ impl Occlusion<'_> {
                     limit: self.shared.limit,
                 });
             }
-            self.range(params, batch, base, half, stats)?;
-            return self.range(params, batch, base + half, count - half, stats);
+            self.range(params, work, base, half, stats)?;
+            return self.range(params, work, base + half, count - half, stats);
         }
         p.work[2] = tiles as u32;
+        let batch = match work {
+            Work::Occlude(batch) => batch,
+            Work::Stencil => {
+                return stats.time("gpu-stencil", || {
+                    let uni = gpu.uniform("params", &p);
+                    let mut enc = gpu.encoder();
+                    let b = gpu.bind(
+                        &pipes.stencil,
+                        &[&uni, self.regions, &tile_counts, self.offsets, self.flags],
+                    );
+                    gpu.dispatch(&mut enc, &pipes.stencil, &b, tiles.div_ceil(64))?;
+                    gpu.submit(enc)
+                });
+            }
+        };
         let chunk_counts = gpu.storage_zeroed("chunk counts", (tiles + 1) * 4)?;
         let chunks = stats.time("gpu-tiles", || {
             let uni = gpu.uniform("params", &p);
@@ -307,6 +368,8 @@ impl Occlusion<'_> {
                     self.masks,
                     self.tallies,
                     self.shared.lut,
+                    self.flags,
+                    self.depths,
                 ],
             );
             gpu.dispatch(&mut enc, &pipes.occlude, &b, chunks)?;
@@ -316,13 +379,14 @@ impl Occlusion<'_> {
 }
 
 /// Occlusion-pass tallies, in the order the shader keeps them.
-pub const TALLIES: [&str; 6] = [
+pub const TALLIES: [&str; 7] = [
     "texels-visited",
     "pairs-tested",
     "pairs-empty",
     "pairs-full",
     "pairs-per-sample",
     "pairs-own-triangle",
+    "pairs-one-sample",
 ];
 
 /// What a batch of view samples gives back.
@@ -337,7 +401,7 @@ pub struct BatchOutput {
     /// The influence regions of the last caster batch (kept for tests).
     pub regions: Vec<Region>,
     /// The occlusion tallies ([`TALLIES`]).
-    pub tallies: [u64; 6],
+    pub tallies: [u64; TALLIES.len()],
 }
 
 /// Runs every pass for one batch of receivers; `params` holds the frame, light and sizes
@@ -356,6 +420,8 @@ pub fn run_batch(
 ) -> Result<BatchOutput, GpuError> {
     let n = receivers.len() as u32;
     params.dims[1] = n;
+    params.options[0] = (!shared.silhouettes.is_empty()) as u32;
+    params.options[1] = shared.semi_opaque as u32;
     let side = params.dims[0];
     let words = params.dims[3];
     let texels = side * side;
@@ -384,12 +450,24 @@ pub fn run_batch(
         gpu.dispatch(&mut enc, &pipes.scatter, &b, groups)?;
         gpu.submit(enc)
     })?;
-    let largest = shared.casters.iter().map(|c| c.len).max().unwrap_or(0);
+    let largest = shared
+        .casters
+        .iter()
+        .chain(shared.silhouettes)
+        .map(|c| c.len)
+        .max()
+        .unwrap_or(0);
     let regions = gpu.storage_zeroed(
         "regions",
         largest as u64 * std::mem::size_of::<Region>() as u64,
     )?;
-    let mut last_regions = Vec::new();
+    let flags = gpu.storage_zeroed("silhouette stencil", texels as u64 * 4)?;
+    let depth_slots = if shared.semi_opaque {
+        n as u64 * params.dims[2] as u64
+    } else {
+        1
+    };
+    let depths = gpu.storage_zeroed("optical depths", depth_slots * 4)?;
     let occ = Occlusion {
         gpu,
         pipes,
@@ -400,26 +478,18 @@ pub fn run_batch(
         lists: &lists,
         masks: &masks,
         tallies: &tallies,
+        flags: &flags,
+        depths: &depths,
     };
+    for batch in shared.silhouettes {
+        occ.batch(params, batch, Work::Stencil, stats)?;
+    }
+    let mut last_regions = Vec::new();
     for batch in shared.casters {
-        let mut p = params;
-        p.kind[0] = batch.len;
-        let uni = gpu.uniform("params", &p);
-        stats.time("gpu-influence", || {
-            let mut enc = gpu.encoder();
-            let b = gpu.bind(&pipes.influence, &[&uni, &batch.buffer, &regions]);
-            gpu.dispatch(
-                &mut enc,
-                &pipes.influence,
-                &b,
-                (batch.len as u64).div_ceil(64),
-            )?;
-            gpu.submit(enc)
-        })?;
+        occ.batch(params, batch, Work::Occlude(batch), stats)?;
         if keep_regions {
             last_regions = gpu.read::<Region>(&regions, batch.len as usize)?;
         }
-        occ.range(p, batch, 0, batch.len, stats)?;
     }
     stats.time("gpu-resolve", || {
         let mut enc = gpu.encoder();
@@ -432,6 +502,7 @@ pub fn run_batch(
                 shared.radiance,
                 &masks,
                 &result,
+                &depths,
             ],
         );
         gpu.dispatch(&mut enc, &pipes.resolve, &b, groups)?;
@@ -439,7 +510,7 @@ pub fn run_batch(
     })?;
     stats.time("gpu-readback", || {
         let t: Vec<u32> = gpu.read(&tallies, TALLY_WORDS)?;
-        let mut tallies = [0u64; 6];
+        let mut tallies = [0u64; TALLIES.len()];
         for (k, v) in tallies.iter_mut().enumerate() {
             *v = t[2 * k] as u64 | (t[2 * k + 1] as u64) << 32;
         }

@@ -15,8 +15,12 @@
 //! section 4.2 needs a fixed set; [`Afsm::set_frame`] rotates them for temporal jittering
 //! (section 4.2, Fig. 7), see [`crate::temporal`].
 //!
-//! Semi-opaque occluders are refused: a bit per light sample records binary visibility, and the
-//! paper's approximate transparency (section 6) is left as future work there.
+//! Semi-opaque occluders: the paper's section 6 approximates transparency by multiplying
+//! casters' transparencies weighted by their coverage, since its bits cannot hold more. Here
+//! each (view sample, light sample) pair of a scene with semi-opaque casters also gets a
+//! fixed-point optical-depth sum that semi-opaque casters add to, so the transmittance product
+//! is exact per sample (to a relative 5e-7 per crossing). Opaque casters keep the bitmask.
+//! Scenes without semi-opaque casters allocate nothing for it.
 
 use std::sync::Arc;
 
@@ -32,7 +36,7 @@ use shadow_core::visibility::{PerSampleVisibility, PixelClass};
 
 use crate::frame::MapFrame;
 use crate::lut::PlaneLut;
-use crate::params::{Caster, LightBounds, Params, Receiver, Region};
+use crate::params::{Caster, LightBounds, OPAQUE, Params, Receiver, Region};
 use crate::passes::{CasterBatch, Pipelines, Shared, TALLIES, run_batch};
 
 /// How the occlusion pass finds the samples behind a plane (section 4.2).
@@ -55,6 +59,9 @@ struct Prepared {
     bounds: LightBounds,
     offset: RayOffset,
     batches: Vec<CasterBatch>,
+    semi_opaque: bool,
+    silhouettes: Vec<CasterBatch>,
+    silhouette_count: usize,
     samples: wgpu::Buffer,
     radiance: wgpu::Buffer,
     lut: wgpu::Buffer,
@@ -110,6 +117,57 @@ fn group_receivers(
     out
 }
 
+/// The edges that can be a silhouette for some point of the light (section 4.3, after Laine et
+/// al. 2005, the paper's \[LAA*05\]), as degenerate casters `(a, b, b)` whose influence
+/// regions make the silhouette stencil: boundary
+/// and non-manifold edges always; a manifold edge unless the whole light lies on the same side
+/// of both faces (opposite sides when the faces disagree in orientation), where no light point
+/// sees one face from the front and the other from the back, and its faces' opacities agree.
+pub fn silhouette_edges(scene: &dyn Scene, bounds: &LightBounds) -> Vec<Caster> {
+    let topo = scene.topology();
+    let positions = scene.positions();
+    let indices = scene.triangles();
+    // Which side of triangle t's plane the whole light lies on: 1 front, -1 back, 0 both.
+    let side = |t: usize| -> i32 {
+        let [a, b, c] = scene.triangle(t);
+        let n = (b - a).cross(c - a);
+        let (lo, hi) = bounds.range(n);
+        let d = n.dot(a);
+        if lo - d > 0.0 {
+            1
+        } else if hi - d < 0.0 {
+            -1
+        } else {
+            0
+        }
+    };
+    // Whether triangle t runs along edge (i, j) from i to j.
+    let forward = |t: usize, i: u32, j: u32| {
+        let tri = indices[t];
+        (0..3).any(|k| tri[k] == i && tri[(k + 1) % 3] == j)
+    };
+    let mut out = Vec::new();
+    for e in 0..topo.edge_count() {
+        let [i, j] = topo.edge(e);
+        let potential = match topo.faces(e) {
+            &[f0, f1] => {
+                let (f0, f1) = (f0 as usize, f1 as usize);
+                let (s0, s1) = (side(f0), side(f1));
+                let consistent = forward(f0, i, j) != forward(f1, i, j);
+                // Transmittance also changes across an edge between different opacities.
+                let opacities = scene.opacities();
+                opacities[f0] != opacities[f1] || s0 == 0 || s1 == 0 || (s0 == s1) != consistent
+            }
+            _ => true,
+        };
+        if potential {
+            let (a, b) = (positions[i as usize], positions[j as usize]);
+            out.push(Caster::new([a, b, b], u32::MAX, false));
+        }
+    }
+    out
+}
+
 /// Alias-free shadow maps (hard) and sample-based visibility (soft) on wgpu.
 pub struct Afsm {
     name: String,
@@ -120,6 +178,7 @@ pub struct Afsm {
     sampler: LightSampler,
     hard: bool,
     plane_test: PlaneTest,
+    stencil: bool,
     memory_limit: Option<u64>,
     prepared: Option<Prepared>,
 }
@@ -174,6 +233,7 @@ impl Afsm {
             sampler,
             hard: false,
             plane_test: PlaneTest::Exact,
+            stencil: false,
             memory_limit: None,
             prepared: None,
         })
@@ -199,6 +259,17 @@ impl Afsm {
         }
         self.plane_test = PlaneTest::Lut;
         Ok(self)
+    }
+
+    /// Turns on the silhouette stencil of section 4.3: the influence regions of the edges that
+    /// can be a silhouette for some light point mark the texels whose view samples can be in
+    /// penumbra; elsewhere one sample per pair stands for all. It pays when occluders are large
+    /// against the light (umbrae far from any silhouette's region); under the built-in scenes'
+    /// large lights every busy texel is marked, so it only adds its passes, and it is off by
+    /// default.
+    pub fn with_silhouette_stencil(mut self) -> Self {
+        self.stencil = true;
+        self
     }
 
     /// Caps every GPU buffer at `bytes` (below the device's own limit), forcing the receiver
@@ -294,21 +365,37 @@ impl Afsm {
             .iter()
             .map(|c| c.closed && c.consistently_oriented)
             .collect();
+        // Fully transparent triangles never hide anything and are left out.
+        let opacities = scene.opacities();
         let casters: Vec<Caster> = (0..scene.triangle_count())
-            .map(|t| Caster::new(scene.triangle(t), t as u32, closed[topo.component_of(t)]))
+            .filter(|&t| opacities[t] > 0.0)
+            .map(|t| {
+                Caster::new(scene.triangle(t), t as u32, closed[topo.component_of(t)])
+                    .with_opacity(opacities[t])
+            })
             .collect();
+        let semi_opaque = casters.iter().any(|c| c.optical_depth != OPAQUE);
         let limit = self.binding_limit(&gpu);
         let per = (limit / std::mem::size_of::<Region>() as u64).max(1) as usize;
-        let batches = casters
-            .chunks(per)
-            .map(|c| {
-                Ok(CasterBatch {
-                    buffer: gpu.storage("casters", c)?,
-                    len: c.len() as u32,
+        let upload = |all: &[Caster], label: &str| {
+            all.chunks(per)
+                .map(|c| {
+                    Ok(CasterBatch {
+                        buffer: gpu.storage(label, c)?,
+                        len: c.len() as u32,
+                    })
                 })
-            })
-            .collect::<Result<Vec<_>, GpuError>>()
-            .map_err(device_error)?;
+                .collect::<Result<Vec<_>, GpuError>>()
+                .map_err(device_error)
+        };
+        let batches = upload(&casters, "casters")?;
+        // The stencil pays only when there are several samples to skip.
+        let edges = if self.stencil && !self.hard && self.samples > 1 {
+            silhouette_edges(scene.as_ref(), &bounds)
+        } else {
+            Vec::new()
+        };
+        let silhouettes = upload(&edges, "silhouette edges")?;
         let sets = self.sets(light.as_ref());
         let positions: Vec<[f32; 4]> = sets
             .iter()
@@ -344,6 +431,9 @@ impl Afsm {
             bounds,
             offset: RayOffset::for_extent(extent),
             batches,
+            semi_opaque,
+            silhouettes,
+            silhouette_count: edges.len(),
             samples,
             radiance,
             lut,
@@ -419,7 +509,10 @@ impl Afsm {
         check_finite(&floats, "view samples").map_err(device_error)?;
         // Batches of receivers within the binding limit.
         let limit = self.binding_limit(&p.gpu);
-        let per_receiver = (words as u64 * 4).max(std::mem::size_of::<Receiver>() as u64);
+        let depths = if p.semi_opaque { n as u64 * 4 } else { 0 };
+        let per_receiver = (words as u64 * 4)
+            .max(depths)
+            .max(std::mem::size_of::<Receiver>() as u64);
         let per_batch = (limit / per_receiver).max(1) as usize;
         let side = view.width().max(view.height()).clamp(8, 4096);
         let side = (1..=side)
@@ -453,7 +546,7 @@ impl Afsm {
             .collect();
         let mut stages = Vec::new();
         let (mut occupied, mut longest, mut batches) = (0u64, 0u64, 0u64);
-        let mut tallies = [0u64; 6];
+        let mut tallies = [0u64; TALLIES.len()];
         let groups = stats.time("frame", || {
             group_receivers(p.bounds.center, &receivers, &pixels, per_batch, side)
         });
@@ -473,6 +566,8 @@ impl Afsm {
                 samples: &p.samples,
                 radiance: &p.radiance,
                 lut: &p.lut,
+                semi_opaque: p.semi_opaque,
+                silhouettes: &p.silhouettes,
                 limit,
             };
             let out = run_batch(
@@ -534,6 +629,7 @@ impl Afsm {
         stats.add("receivers-facing-away", facing_away);
         stats.add("receiver-batches", batches);
         stats.add("caster-batches", p.batches.len() as u64);
+        stats.add("silhouette-edges", p.silhouette_count as u64);
         stats.add("lists-occupied", occupied);
         stats.add("list-length-max", longest);
         stats.add("map-side", side as u64);
@@ -565,7 +661,7 @@ impl ShadowTechnique for Afsm {
                 LightKind::Sphere,
                 LightKind::Point,
             ],
-            semi_opaque: false,
+            semi_opaque: true,
             textured_lights: true,
             needs_closed_meshes: false,
             sample_based: !self.hard,
@@ -581,6 +677,7 @@ impl ShadowTechnique for Afsm {
             "frame": self.frame,
             "hard": self.hard,
             "plane_test": format!("{:?}", self.plane_test),
+            "silhouette_stencil": self.stencil && !self.hard && self.samples > 1,
             "lut_bins": (self.plane_test == PlaneTest::Lut).then(|| crate::lut::bins_for(self.samples)),
             "adapter": self.adapter(),
         })

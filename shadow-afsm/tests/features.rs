@@ -16,6 +16,31 @@ fn setup_view(name: &str, w: u32, h: u32) -> (SceneSetup, ViewSamples) {
     (setup, view)
 }
 
+/// Meshes over an 8 x 8 floor under a square light of side `light` at height `height`, seen
+/// from above at `w` x `h`.
+fn floor_scene(
+    meshes: Vec<MeshDesc>,
+    light: f32,
+    height: f32,
+    w: u32,
+    h: u32,
+) -> (SceneRef, Light, ViewSamples) {
+    use glam::Vec3;
+    let mut b = SceneBuilder::new();
+    let f = shadow_core::procedural::floor(8.0, 0.0);
+    b.push_mesh(MeshDesc::new(f.0, f.1)).unwrap();
+    for m in meshes {
+        b.push_mesh(m).unwrap();
+    }
+    let scene: SceneRef = Arc::new(b.build().unwrap());
+    let radiance = Radiance::constant(Vec3::ONE).unwrap();
+    let light: Light =
+        Arc::new(RectLight::facing(Vec3::Y * height, Vec3::NEG_Y, light, light, radiance).unwrap());
+    let cam = Camera::look_at(Vec3::new(0.0, 3.5, 3.0), Vec3::ZERO, Vec3::Y, 0.9).unwrap();
+    let view = ViewSamples::render(scene.as_ref(), &cam, w, h).unwrap();
+    (scene, light, view)
+}
+
 fn stratified_reference(setup: &SceneSetup, view: &ViewSamples) -> VisibilityImage {
     let mut r = Reference::stratified(1024, 99).unwrap();
     r.prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
@@ -126,4 +151,117 @@ fn bad_parameters_are_refused() {
             .with_lut()
             .is_err()
     );
+}
+
+/// Section 4.3's silhouette stencil: under a finely tessellated closed sphere lit by a small
+/// light, view samples in the umbra are off every silhouette edge's influence region, so one
+/// sample per pair stands for all; the bits equal those of the full per-sample test and the
+/// per-sample work falls. Built-in scenes' large lights leave no texel off the stencil, which
+/// is why the stencil is opt-in (`docs/benchmarks.md`).
+#[test]
+fn silhouette_stencil_changes_no_bit_and_skips_umbra_work() {
+    if context_for_test("silhouette_stencil_changes_no_bit_and_skips_umbra_work").is_none() {
+        return;
+    }
+    let s = shadow_core::procedural::uv_sphere(glam::Vec3::new(0.0, 1.2, 0.0), 0.7, 24, 48);
+    let (scene, light, view) = floor_scene(vec![MeshDesc::new(s.0, s.1)], 0.3, 4.0, 48, 36);
+    assert!(scene.topology().components().iter().any(|c| c.closed));
+    let run = |stencil: bool| {
+        let mut a = Afsm::new(64, SamplingStrategy::Interleaved { tile: 2 }, 4).unwrap();
+        if stencil {
+            a = a.with_silhouette_stencil();
+        }
+        a.prepare(scene.clone(), Arc::clone(&light)).unwrap();
+        let est = a.estimate(&view).unwrap();
+        let mut r = Reference::same_samples(a.light_sampler().unwrap().clone());
+        r.prepare(scene.clone(), Arc::clone(&light)).unwrap();
+        let truth = r.estimate(&view).unwrap().visibility;
+        (est, truth)
+    };
+    let (plain, truth) = run(false);
+    let (restricted, _) = run(true);
+    let m = compare(&restricted.visibility, &plain.visibility).unwrap();
+    let t = compare(&restricted.visibility, &truth).unwrap();
+    let count = |e: &Estimate, k: &str| e.stats.counter(k);
+    println!(
+        "silhouette edges {} of the sphere's; per-sample pairs {} -> {}, one-sample pairs {}; \
+         agreement with the plain run {:.6}, with the reference {:.6}",
+        count(&restricted, "silhouette-edges"),
+        count(&plain, "pairs-per-sample"),
+        count(&restricted, "pairs-per-sample"),
+        count(&restricted, "pairs-one-sample"),
+        m.sample_agreement.unwrap(),
+        t.sample_agreement.unwrap(),
+    );
+    assert_eq!(count(&plain, "pairs-one-sample"), 0);
+    assert!(count(&restricted, "pairs-one-sample") > 0);
+    // Measured: 1904 -> 1214 per-sample pairs (690 one-sample).
+    assert!(
+        count(&restricted, "pairs-per-sample") * 4 < count(&plain, "pairs-per-sample") * 3,
+        "the stencil should cut the per-sample work by a quarter or more here"
+    );
+    assert!(m.sample_agreement.unwrap() >= 0.9999, "{m:?}");
+    assert!(t.sample_agreement.unwrap() >= 0.999, "{t:?}");
+}
+
+/// Semi-opaque casters (section 6's transparency, kept exactly per sample): with the silhouette
+/// stencil on (edges between different opacities count as silhouettes) the values equal the
+/// same-samples reference's transmittance products.
+#[test]
+fn semi_opaque_transmittance_matches_the_reference_with_the_stencil() {
+    if context_for_test("semi_opaque_transmittance_matches_the_reference_with_the_stencil")
+        .is_none()
+    {
+        return;
+    }
+    let (setup, view) = setup_view("semi-opaque", 48, 36);
+    let mut a = Afsm::new(64, SamplingStrategy::Interleaved { tile: 2 }, 6)
+        .unwrap()
+        .with_silhouette_stencil();
+    a.prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
+        .unwrap();
+    let est = a.estimate(&view).unwrap();
+    let mut r = Reference::same_samples(a.light_sampler().unwrap().clone());
+    r.prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
+        .unwrap();
+    let m = compare(&est.visibility, &r.estimate(&view).unwrap().visibility).unwrap();
+    println!("{m:?}");
+    assert!(m.rmse < 1e-4 && m.max_abs < 1e-3, "{m:?}");
+    assert!(m.sample_agreement.unwrap() >= 0.999, "{m:?}");
+}
+
+/// 298 stacked panels of opacity `1 - 18 * 2^-24` add up an optical depth of 298 x 13.745 =
+/// 4096.06 nats, just beyond the 4096 nats a 32-bit sum of 2^-20-nat units holds: wrapping
+/// would leave 0.06 nats and light the umbra at 94%. The sums saturate instead (transmittance
+/// 0, as the reference's underflowing product).
+#[test]
+fn optical_depth_sums_saturate_instead_of_wrapping() {
+    if context_for_test("optical_depth_sums_saturate_instead_of_wrapping").is_none() {
+        return;
+    }
+    let opacity = 1.0 - 18.0 / 16_777_216.0;
+    let panels = (0..298)
+        .map(|k| {
+            let q = shadow_core::procedural::quad(
+                glam::Vec3::new(0.0, 1.0 + k as f32 * 0.002, 0.0),
+                glam::Vec3::X * 0.6,
+                glam::Vec3::Z * 0.6,
+            );
+            MeshDesc::new(q.0, q.1).with_opacity(opacity)
+        })
+        .collect();
+    let (scene, light, view) = floor_scene(panels, 0.5, 3.0, 32, 24);
+    let mut a = Afsm::new(32, SamplingStrategy::Correlated, 2).unwrap();
+    a.prepare(scene.clone(), Arc::clone(&light)).unwrap();
+    let est = a.estimate(&view).unwrap();
+    let mut r = Reference::same_samples(a.light_sampler().unwrap().clone());
+    r.prepare(scene, light).unwrap();
+    let truth = r.estimate(&view).unwrap().visibility;
+    let m = compare(&est.visibility, &truth).unwrap();
+    let umbra = (0..view.len())
+        .filter(|&i| view.is_valid(i) && truth.value(i) == 0.0)
+        .count();
+    println!("umbra pixels {umbra}, {m:?}");
+    assert!(umbra > 20);
+    assert!(m.rmse < 1e-3 && m.max_abs < 1e-2, "{m:?}");
 }

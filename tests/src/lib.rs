@@ -35,6 +35,7 @@ pub fn registry() -> Vec<Preset> {
     all.extend(shadow_ref::presets());
     all.extend(shadow_dcs::presets());
     all.extend(shadow_ssm::presets());
+    all.extend(shadow_afsm::presets());
     all
 }
 

@@ -1,22 +1,35 @@
 //! The conformance suite: every registered preset on every built-in scene, every check.
 //! Unsupported combinations are listed with their reason, never dropped.
 
+use shadow_core::preset::Preset;
 use shadow_core::scenes::{BUILTIN_SCENES, builtin};
+use shadow_core::technique::Processor;
 use shadow_tests::closed_form::{masked, quad_over_plane_buffer};
-use shadow_tests::conformance::{Outcome, SceneContext, SuiteConfig, run_case};
+use shadow_tests::conformance::{
+    GPU_TEST_RESOLUTION, Outcome, SceneContext, SuiteConfig, run_case,
+};
 use shadow_tests::registry;
 
 #[test]
 fn every_preset_on_every_builtin_scene() {
     let cfg = SuiteConfig::default();
+    // GPU presets run smaller here (see `GPU_TEST_RESOLUTION`).
+    let gpu_cfg = SuiteConfig {
+        width: GPU_TEST_RESOLUTION.0,
+        height: GPU_TEST_RESOLUTION.1,
+        ..cfg
+    };
     let presets = registry();
     assert!(!presets.is_empty());
+    let on_gpu = |p: &Preset| (p.make)(cfg.seed).capabilities().processor == Processor::Gpu;
     let mut failures = Vec::new();
     let mut ran = 0;
     for scene in BUILTIN_SCENES {
         let ctx = SceneContext::new(builtin(scene).unwrap(), cfg).unwrap();
+        let gpu_ctx = SceneContext::new(builtin(scene).unwrap(), gpu_cfg).unwrap();
         for p in &presets {
-            match run_case(p, &ctx) {
+            let ctx = if on_gpu(p) { &gpu_ctx } else { &ctx };
+            match run_case(p, ctx) {
                 Outcome::Unsupported { reason } => {
                     println!("{:<12} {:<22} unsupported: {reason}", p.name, scene)
                 }

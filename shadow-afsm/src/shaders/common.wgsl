@@ -23,6 +23,9 @@ struct Params {
     lut: vec4<u32>,
     // The occlusion work of one range of casters: first caster, caster count, tiles, chunks.
     work: vec4<u32>,
+    // x = 1 when the silhouette stencil restricts per-sample work (section 4.3); y = 1 when
+    // semi-opaque casters accumulate per-sample optical depths.
+    options: vec4<u32>,
     // Up to 8 points bounding the light (rectangle corners, polygon outline or its box).
     outline: array<vec4<f32>, 8>,
 }
@@ -42,14 +45,18 @@ struct Receiver {
 }
 
 struct Caster {
-    // Vertices, the triangle id, and 1 when its mesh is closed.
+    // Vertices, the triangle id, 1 when its mesh is closed, and the optical depth of one
+    // crossing (-ln(1 - opacity) in units of 1 / DEPTH_SCALE; OPAQUE for opaque casters).
     a: vec3<f32>,
     id: u32,
     b: vec3<f32>,
     closed: u32,
     c: vec3<f32>,
-    pad: u32,
+    optical_depth: u32,
 }
+
+const DEPTH_SCALE: f32 = 1048576.0;
+const OPAQUE: u32 = 0xffffffffu;
 
 const MAX_HULL: u32 = 28u;
 

@@ -26,6 +26,73 @@ fn culled(t: u32) {
     regions[t].info = vec4<u32>(0u, 0u, 0u, 0u);
 }
 
+fn lex_less(a: vec2<f32>, b: vec2<f32>) -> bool {
+    return a.x < b.x || (a.x == b.x && a.y < b.y);
+}
+
+// Merges the ring pts[off .. off + cnt) (a convex polygon in cyclic order, cnt <= 8) into the
+// sorted points out[0 .. s) and returns the new count. From the ring's lexicographic minimum,
+// the forward and the backward walks to its maximum are both sorted: merging them sorts the
+// ring in O(cnt), and one pass from the back merges it into `out`.
+fn merge_ring(pts: ptr<function, array<vec2<f32>, 28>>, off: u32, cnt: u32,
+              out: ptr<function, array<vec2<f32>, 28>>, s: u32) -> u32 {
+    if cnt == 0u {
+        return s;
+    }
+    var lo = 0u;
+    var hi = 0u;
+    for (var j = 1u; j < cnt; j++) {
+        let p = (*pts)[off + j];
+        if lex_less(p, (*pts)[off + lo]) {
+            lo = j;
+        }
+        if lex_less((*pts)[off + hi], p) {
+            hi = j;
+        }
+    }
+    var run: array<vec2<f32>, 8>;
+    var r = 0u;
+    if lo == hi {
+        // Every point equal (or one point): any order is sorted.
+        for (var j = 0u; j < cnt; j++) {
+            run[j] = (*pts)[off + j];
+        }
+        r = cnt;
+    } else {
+        run[0] = (*pts)[off + lo];
+        r = 1u;
+        var a = (lo + 1u) % cnt;
+        var b = (lo + cnt - 1u) % cnt;
+        while a != hi || b != hi {
+            let take_a = a != hi && (b == hi || !lex_less((*pts)[off + b], (*pts)[off + a]));
+            if take_a {
+                run[r] = (*pts)[off + a];
+                a = (a + 1u) % cnt;
+            } else {
+                run[r] = (*pts)[off + b];
+                b = (b + cnt - 1u) % cnt;
+            }
+            r++;
+        }
+        run[r] = (*pts)[off + hi];
+        r++;
+    }
+    var i = i32(s) - 1;
+    var j = i32(r) - 1;
+    var w = i32(s + r) - 1;
+    while j >= 0 {
+        if i >= 0 && lex_less(run[j], (*out)[i]) {
+            (*out)[w] = (*out)[i];
+            i--;
+        } else {
+            (*out)[w] = run[j];
+            j--;
+        }
+        w--;
+    }
+    return s + r;
+}
+
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n: vec3<u32>) {
     let t = linear_index(g, n);
@@ -53,8 +120,12 @@ fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n:
         culled(t);
         return;
     }
+    // Group 0: the vertices' projections (three points are always in cyclic order). Group
+    // k + 1: the light's bounding points seen through vertex k, in the cyclic order of the
+    // light's outline (a central projection keeps a convex polygon convex and in order).
     var pts: array<vec2<f32>, 28>;
-    var m = 0u;
+    var m = 3u;
+    var ny = 0u;
     for (var k = 0u; k < 3u; k++) {
         let vk = v[k];
         let zv = dot(vk - c, d);
@@ -62,11 +133,9 @@ fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n:
             whole_map(t);
             return;
         }
-        pts[m] = to_texel(project(vk).xy);
-        m++;
+        pts[k] = to_texel(project(vk).xy);
         // The points bounding the light as seen through this vertex.
         var ys: array<vec3<f32>, 8>;
-        var ny = 0u;
         switch P.kind.y {
             case 1u: {
                 let rad = P.light_n.w / cos(3.14159265 / 8.0);
@@ -125,7 +194,7 @@ fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n:
             m++;
         }
     }
-    // Bounding box, then the convex hull (monotone chain after an insertion sort by x, y).
+    // Bounding box, then the convex hull (a monotone chain over the points sorted in O(n)).
     var lo = pts[0];
     var hi = pts[0];
     for (var k = 1u; k < m; k++) {
@@ -144,31 +213,40 @@ fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n:
         clamp(i32(floor(lo.y - eps)), 0, s1),
         clamp(i32(floor(hi.x + eps)), 0, s1),
         clamp(i32(floor(hi.y + eps)), 0, s1));
+    // Sorted by x, then y, in O(n) (section 4.1): each group's cyclic order splits at its
+    // lexicographic extremes into two sorted chains, merged into the sorted points so far. The
+    // insertion sort that follows costs one comparison per point when the merge is sorted, and
+    // repairs the order where rounding made a group not quite convex.
+    var sorted: array<vec2<f32>, 28>;
+    var count = merge_ring(&pts, 0u, 3u, &sorted, 0u);
+    for (var k = 0u; k < 3u; k++) {
+        count = merge_ring(&pts, 3u + k * ny, ny, &sorted, count);
+    }
     for (var i = 1u; i < m; i++) {
-        let p = pts[i];
+        let p = sorted[i];
         var j = i;
-        while j > 0u && (pts[j - 1u].x > p.x || (pts[j - 1u].x == p.x && pts[j - 1u].y > p.y)) {
-            pts[j] = pts[j - 1u];
+        while j > 0u && lex_less(p, sorted[j - 1u]) {
+            sorted[j] = sorted[j - 1u];
             j--;
         }
-        pts[j] = p;
+        sorted[j] = p;
     }
     var hull: array<vec2<f32>, 29>;
     var h = 0u;
     for (var i = 0u; i < m; i++) {
-        while h >= 2u && cross2(hull[h - 2u], hull[h - 1u], pts[i]) <= 0.0 {
+        while h >= 2u && cross2(hull[h - 2u], hull[h - 1u], sorted[i]) <= 0.0 {
             h--;
         }
-        hull[h] = pts[i];
+        hull[h] = sorted[i];
         h++;
     }
     let lower = h + 1u;
     for (var ii = 1u; ii < m; ii++) {
         let i = m - 1u - ii;
-        while h >= lower && cross2(hull[h - 2u], hull[h - 1u], pts[i]) <= 0.0 {
+        while h >= lower && cross2(hull[h - 2u], hull[h - 1u], sorted[i]) <= 0.0 {
             h--;
         }
-        hull[h] = pts[i];
+        hull[h] = sorted[i];
         h++;
     }
     if h > 1u {

@@ -27,12 +27,14 @@
 @group(0) @binding(9) var<storage, read_write> masks: array<atomic<u32>>;
 @group(0) @binding(10) var<storage, read_write> stats: array<atomic<u32>>;
 @group(0) @binding(11) var<storage, read> lut: array<u32>;
+@group(0) @binding(12) var<storage, read> flags: array<u32>;
+@group(0) @binding(13) var<storage, read_write> depths: array<atomic<u32>>;
 
 // The tile's list lengths (then their inclusive running sum), texel indices, and the pair
 // outcomes of the workgroup.
 var<workgroup> prefix: array<u32, 64>;
 var<workgroup> texels: array<u32, 64>;
-var<workgroup> outcomes: array<atomic<u32>, 4>;
+var<workgroup> outcomes: array<atomic<u32>, 5>;
 
 // LUT cell of the oriented plane {y : dot(m, y - base) >= 0}.
 fn lut_cell(m: vec3<f32>, base: vec3<f32>) -> u32 {
@@ -52,9 +54,52 @@ fn lut_cell(m: vec3<f32>, base: vec3<f32>) -> u32 {
     return (it * np + ip) * nd + id;
 }
 
-// Tests receiver `i` against caster `t` and ORs the occluded samples into its mask. Returns 0
-// for the receiver's own triangle, 1 for an empty pair, 2 for a full one, 3 for per-sample work.
-fn occlude_pair(t: u32, i: u32) -> u32 {
+// Whether light sample y lies inside every live plane.
+fn inside_planes(y: vec3<f32>, ms: ptr<function, array<vec3<f32>, 4>>,
+                 bs: ptr<function, array<f32, 4>>, live: ptr<function, array<u32, 4>>,
+                 na: u32) -> bool {
+    var inside = true;
+    for (var q = 0u; q < na; q++) {
+        let p = (*live)[q];
+        let f = dot((*ms)[p], y) - (*bs)[p];
+        inside = inside && select(f >= 0.0, f > 0.0, p == 0u);
+    }
+    return inside;
+}
+
+// Hides the samples of word wd set in `bits` from receiver i behind a caster of optical depth
+// `depth`: opaque casters OR the bits into the mask; semi-opaque ones add their optical depth
+// to each sample's sum (section 6's transparency, exact per sample), saturating at OPAQUE.
+fn hide(i: u32, wd: u32, bits: u32, depth: u32) {
+    if depth == OPAQUE {
+        atomicOr(&masks[i * P.dims.w + wd], bits);
+        return;
+    }
+    var b = bits;
+    while b != 0u {
+        let slot = i * P.dims.z + wd * 32u + firstTrailingBit(b);
+        b &= b - 1u;
+        let old = atomicAdd(&depths[slot], depth);
+        if old > OPAQUE - depth {
+            atomicMax(&depths[slot], OPAQUE);
+        }
+    }
+}
+
+// Hides all N samples of receiver i.
+fn hide_all(i: u32, depth: u32) {
+    let n_samples = P.dims.z;
+    for (var wd = 0u; wd < P.dims.w; wd++) {
+        let rest = n_samples - wd * 32u;
+        hide(i, wd, select((1u << rest) - 1u, 0xffffffffu, rest >= 32u), depth);
+    }
+}
+
+// Tests receiver `i` against caster `t` and ORs the occluded samples into its mask; `one`
+// when the receiver's texel is off the silhouette stencil (one sample stands for all). Returns
+// 0 for the receiver's own triangle, 1 for an empty pair, 2 for a full one, 3 for per-sample
+// work, 4 for a one-sample test.
+fn occlude_pair(t: u32, i: u32, one: bool) -> u32 {
     let tri = casters[t];
     let a = tri.a;
     let b = tri.b;
@@ -104,13 +149,17 @@ fn occlude_pair(t: u32, i: u32) -> u32 {
     }
     let n_samples = P.dims.z;
     let words = P.dims.w;
+    let depth = tri.optical_depth;
     if na == 0u {
-        for (var wd = 0u; wd < words; wd++) {
-            let rest = n_samples - wd * 32u;
-            let bits = select((1u << rest) - 1u, 0xffffffffu, rest >= 32u);
-            atomicOr(&masks[i * words + wd], bits);
-        }
+        hide_all(i, depth);
         return 2u;
+    }
+    let first = r.set_index * n_samples;
+    if one {
+        if inside_planes(samples[first].xyz, &ms, &bs, &live, na) {
+            hide_all(i, depth);
+        }
+        return 4u;
     }
     if P.kind.w == 1u {
         var cells: array<u32, 4>;
@@ -126,30 +175,22 @@ fn occlude_pair(t: u32, i: u32) -> u32 {
                 bits &= lut[cells[q] * words + wd];
             }
             if bits != 0u {
-                atomicOr(&masks[i * words + wd], bits);
+                hide(i, wd, bits, depth);
             }
         }
         return 3u;
     }
-    let first = r.set_index * n_samples;
     for (var wd = 0u; wd < words; wd++) {
         var bits = 0u;
         let k0 = wd * 32u;
         let k1 = min(k0 + 32u, n_samples);
         for (var kk = k0; kk < k1; kk++) {
-            let y = samples[first + kk].xyz;
-            var inside = true;
-            for (var q = 0u; q < na; q++) {
-                let p = live[q];
-                let f = dot(ms[p], y) - bs[p];
-                inside = inside && select(f >= 0.0, f > 0.0, p == 0u);
-            }
-            if inside {
+            if inside_planes(samples[first + kk].xyz, &ms, &bs, &live, na) {
                 bits |= 1u << (kk - k0);
             }
         }
         if bits != 0u {
-            atomicOr(&masks[i * words + wd], bits);
+            hide(i, wd, bits, depth);
         }
     }
     return 3u;
@@ -197,14 +238,17 @@ fn main(@builtin(local_invocation_index) li: u32, @builtin(workgroup_id) w: vec3
         }
         let before = select(0u, prefix[max(k, 1u) - 1u], k > 0u);
         let i = lists[offsets[texels[k]] + e - before];
-        atomicAdd(&outcomes[occlude_pair(tl.caster, i)], 1u);
+        let one = P.options.x == 1u && flags[texels[k]] == 0u;
+        atomicAdd(&outcomes[occlude_pair(tl.caster, i, one)], 1u);
     }
     workgroupBarrier();
-    // Tallies by outcome (empty, full, per-sample, own triangle), once per workgroup.
+    // Tallies by outcome (empty, full, per-sample, own triangle, one sample), once per
+    // workgroup.
     if li == 0u {
         add64(2u, atomicLoad(&outcomes[1]));
         add64(3u, atomicLoad(&outcomes[2]));
         add64(4u, atomicLoad(&outcomes[3]));
         add64(5u, atomicLoad(&outcomes[0]));
+        add64(6u, atomicLoad(&outcomes[4]));
     }
 }

@@ -1,6 +1,6 @@
 // Per tile: the texels that overlap the caster's region and hold a list (tally 0, texels
 // visited), the pairs they hold (tally 1), and the chunks of 64 pairs the occlusion pass runs
-// (`chunk_counts`, summed into tally 7).
+// (`chunk_counts`, summed into tally 8).
 
 @group(0) @binding(0) var<uniform> P: Params;
 @group(0) @binding(4) var<storage, read_write> chunk_counts: array<u32>;
@@ -24,5 +24,5 @@ fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n:
     chunk_counts[u] = chunks;
     add64(0u, visited);
     add64(1u, pairs);
-    add64(7u, chunks);
+    add64(8u, chunks);
 }
