@@ -40,13 +40,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let re = r.estimate(&view)?;
     let t_ref = t0.elapsed().as_secs_f64();
     let m = compare(&est.visibility, &re.visibility)?;
+    // Error against the converged answer (1024 stratified samples): equal for both at equal N.
+    let mut truth = Reference::stratified(1024, 77)?;
+    truth.prepare(setup.scene.clone(), Arc::clone(&light))?;
+    let truth = truth.estimate(&view)?.visibility;
+    let e_afsm = compare(&est.visibility, &truth)?.rmse;
+    let e_ref = compare(&re.visibility, &truth)?.rmse;
     println!("adapter: {}", afsm.adapter().unwrap_or_default());
     println!(
         "{scene} {w}x{h} N={n} {mode}: afsm {t_afsm:.3} s, reference (same samples, CPU) {t_ref:.3} s, ratio {:.2}",
         t_ref / t_afsm
     );
     println!(
-        "agreement {:.6} rmse {:.5}",
+        "agreement with the same-samples reference {:.6}, rmse {:.5}; rmse against 1024 \
+         stratified samples: afsm {e_afsm:.5}, same-samples reference {e_ref:.5}",
         m.sample_agreement.unwrap_or(0.0),
         m.rmse
     );

@@ -280,16 +280,17 @@ impl Occlusion<'_> {
         if tiles == 0 {
             return Ok(());
         }
-        let max_tiles = (self.shared.limit / 4)
+        // Three words per tile: its chunk count and its 64-bit overlap mask.
+        let max_tiles = (self.shared.limit / 12)
             .saturating_sub(1)
-            .min(u32::MAX as u64 - 1);
+            .min(u32::MAX as u64 / 3 - 1);
         if tiles > max_tiles {
             // One caster covers at most (side / 8)^2 tiles, which the map's own buffer bounds.
             let half = count / 2;
             if half == 0 {
                 return Err(GpuError::TooLarge {
                     what: "tile numbering of one caster".into(),
-                    needed: (tiles + 1) * 4,
+                    needed: (3 * tiles + 1) * 4,
                     limit: self.shared.limit,
                 });
             }
@@ -312,7 +313,8 @@ impl Occlusion<'_> {
                 });
             }
         };
-        let chunk_counts = gpu.storage_zeroed("chunk counts", (tiles + 1) * 4)?;
+        // Chunk counts (scanned in place), then two words of overlap mask per tile.
+        let chunk_counts = gpu.storage_zeroed("chunk counts", (3 * tiles + 1) * 4)?;
         let chunks = stats.time("gpu-tiles", || {
             let uni = gpu.uniform("params", &p);
             let mut enc = gpu.encoder();

@@ -54,17 +54,16 @@ fn lut_cell(m: vec3<f32>, base: vec3<f32>) -> u32 {
     return (it * np + ip) * nd + id;
 }
 
-// Whether light sample y lies inside every live plane.
-fn inside_planes(y: vec3<f32>, ms: ptr<function, array<vec3<f32>, 4>>,
-                 bs: ptr<function, array<f32, 4>>, live: ptr<function, array<u32, 4>>,
-                 na: u32) -> bool {
-    var inside = true;
-    for (var q = 0u; q < na; q++) {
-        let p = (*live)[q];
-        let f = dot((*ms)[p], y) - (*bs)[p];
-        inside = inside && select(f >= 0.0, f > 0.0, p == 0u);
-    }
-    return inside;
+// Whether light sample y lies inside the four oriented planes (strictly for the supporting
+// plane q = 0); a plane dropped by the whole-light classification is (0, -1), always inside.
+// Branch-free: no loop over the live planes, so every invocation runs the same code.
+fn inside4(y: vec3<f32>, ms: ptr<function, array<vec3<f32>, 4>>,
+           bs: ptr<function, array<f32, 4>>) -> bool {
+    let f0 = dot((*ms)[0], y) - (*bs)[0];
+    let f1 = dot((*ms)[1], y) - (*bs)[1];
+    let f2 = dot((*ms)[2], y) - (*bs)[2];
+    let f3 = dot((*ms)[3], y) - (*bs)[3];
+    return f0 > 0.0 && min(min(f1, f2), f3) >= 0.0;
 }
 
 // Hides the samples of word wd set in `bits` from receiver i behind a caster of optical depth
@@ -131,6 +130,7 @@ fn occlude_pair(t: u32, i: u32, one: bool) -> u32 {
     bs[2] = dot(ms[2], o);
     bs[3] = dot(ms[3], o);
     var live: array<u32, 4>;
+    var cuts: array<bool, 4>;
     var na = 0u;
     var empty = false;
     for (var p = 0u; p < 4u; p++) {
@@ -139,6 +139,7 @@ fn occlude_pair(t: u32, i: u32, one: bool) -> u32 {
         let outside = select(rg.y < 0.0, rg.y <= 0.0, p == 0u);
         let inside = select(rg.x >= 0.0, rg.x > 0.0, p == 0u);
         empty = empty || outside;
+        cuts[p] = !inside;
         if !inside {
             live[na] = p;
             na++;
@@ -146,6 +147,15 @@ fn occlude_pair(t: u32, i: u32, one: bool) -> u32 {
     }
     if empty {
         return 1u;
+    }
+    // The exact test's planes: those that do not cut the light always hold.
+    var tm = ms;
+    var tb = bs;
+    for (var p = 0u; p < 4u; p++) {
+        if !cuts[p] {
+            tm[p] = vec3<f32>(0.0);
+            tb[p] = -1.0;
+        }
     }
     let n_samples = P.dims.z;
     let words = P.dims.w;
@@ -156,7 +166,7 @@ fn occlude_pair(t: u32, i: u32, one: bool) -> u32 {
     }
     let first = r.set_index * n_samples;
     if one {
-        if inside_planes(samples[first].xyz, &ms, &bs, &live, na) {
+        if inside4(samples[first].xyz, &tm, &tb) {
             hide_all(i, depth);
         }
         return 4u;
@@ -185,7 +195,7 @@ fn occlude_pair(t: u32, i: u32, one: bool) -> u32 {
         let k0 = wd * 32u;
         let k1 = min(k0 + 32u, n_samples);
         for (var kk = k0; kk < k1; kk++) {
-            if inside_planes(samples[first + kk].xyz, &ms, &bs, &live, na) {
+            if inside4(samples[first + kk].xyz, &tm, &tb) {
                 bits |= 1u << (kk - k0);
             }
         }
@@ -215,9 +225,15 @@ fn main(@builtin(local_invocation_index) li: u32, @builtin(workgroup_id) w: vec3
         }
     }
     let tl = tile_of(lo);
-    let tt = tile_texel(tl, li);
-    texels[li] = tt.x;
-    prefix[li] = tt.y;
+    // The tile's overlap mask (from `tile_pairs`): texels off the hull or with empty lists are 0.
+    let bit = (chunk_offsets[P.work.z + 1u + 2u * lo + li / 32u] >> (li % 32u)) & 1u;
+    let texel = tile_texel_index(tl, li);
+    var len = 0u;
+    if bit == 1u {
+        len = offsets[texel + 1u] - offsets[texel];
+    }
+    texels[li] = texel;
+    prefix[li] = len;
     workgroupBarrier();
     for (var s = 1u; s < 64u; s <<= 1u) {
         let add = select(0u, prefix[li - s], li >= s);

@@ -63,6 +63,14 @@ fn texel_overlaps(t: u32, tx: i32, ty: i32) -> bool {
     return inside;
 }
 
+// The map index of texel `k` (0..64, row-major) of a tile (past the map's edge when the tile
+// overhangs the region's box).
+fn tile_texel_index(tl: Tile, k: u32) -> u32 {
+    let tx = tl.origin.x + i32(k % u32(TILE));
+    let ty = tl.origin.y + i32(k / u32(TILE));
+    return u32(ty) * P.dims.x + u32(tx);
+}
+
 // Texel `k` (0..64, row-major) of a tile: its index and the length of its list, 0 when it lies
 // outside the region's box or hull (empty lists are skipped, section 4.3).
 fn tile_texel(tl: Tile, k: u32) -> vec2<u32> {
@@ -71,7 +79,7 @@ fn tile_texel(tl: Tile, k: u32) -> vec2<u32> {
     if tx > tl.last.x || ty > tl.last.y {
         return vec2<u32>(0u);
     }
-    let texel = u32(ty) * P.dims.x + u32(tx);
+    let texel = tile_texel_index(tl, k);
     let len = offsets[texel + 1u] - offsets[texel];
     if len == 0u || !texel_overlaps(tl.caster, tx, ty) {
         return vec2<u32>(texel, 0u);
