@@ -13,7 +13,8 @@
 //!   AND over planes and atomic OR over triangles (section 4.2); computations restricted to
 //!   non-empty lists, to the planes that cut the light and by conservative back-face culling
 //!   (section 4.3).
-//! * [`lut`]: the plane lookup table of section 4.2.
+//! * [`lut`]: the plane lookup table of section 4.2; [`sample_grid`]: light samples bucketed
+//!   on a planar light so the exact test visits only those a triangle's projection covers.
 //! * [`technique`]: the [`Afsm`] technique (hard shadows of section 3 and soft shadows of
 //!   section 4 with N = 1 to 1024 samples), [`temporal`]: temporal jittering (Fig. 7).
 //! * [`params`]: the data layout shared with the shaders.
@@ -32,6 +33,7 @@ pub mod lut;
 pub mod params;
 pub mod passes;
 mod presets;
+pub mod sample_grid;
 pub mod technique;
 pub mod temporal;
 

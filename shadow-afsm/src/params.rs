@@ -45,8 +45,11 @@ pub struct Params {
     /// Occlusion work of one caster range: first caster, caster count, tiles, chunks.
     pub work: [u32; 4],
     /// x = 1 when the silhouette stencil restricts per-sample work; y = 1 when semi-opaque
-    /// casters accumulate per-sample optical depths.
+    /// casters accumulate per-sample optical depths; z = buckets per side of the sample grid
+    /// (0: none).
     pub options: [u32; 4],
+    /// Sample grid origin (u, v) and buckets per unit (u, v) in the light's plane.
+    pub grid: [f32; 4],
     /// Points bounding the light.
     pub outline: [[f32; 4]; 8],
 }

@@ -38,6 +38,7 @@ use crate::frame::MapFrame;
 use crate::lut::PlaneLut;
 use crate::params::{Caster, LightBounds, OPAQUE, Params, Receiver, Region};
 use crate::passes::{CasterBatch, Pipelines, Shared, TALLIES, run_batch};
+use crate::sample_grid::SampleGrid;
 
 /// How the occlusion pass finds the samples behind a plane (section 4.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -65,6 +66,7 @@ struct Prepared {
     samples: wgpu::Buffer,
     radiance: wgpu::Buffer,
     lut: wgpu::Buffer,
+    grid: Option<(u32, [f32; 4])>,
     sample_positions: Vec<Vec3>,
 }
 
@@ -410,9 +412,26 @@ impl Afsm {
         check_finite(positions.as_flattened(), "light samples").map_err(device_error)?;
         check_finite(radiance.as_flattened(), "light sample radiance").map_err(device_error)?;
         let sample_positions: Vec<Vec3> = sets.iter().flatten().map(|s| s.position).collect();
+        // The plane table, or for the exact test the samples bucketed on a planar light.
+        let mut grid = None;
         let lut_data = match self.plane_test {
             PlaneTest::Lut => PlaneLut::build(&bounds, &sample_positions).data,
-            PlaneTest::Exact => vec![0u32; 4],
+            PlaneTest::Exact => {
+                let per_set: Vec<Vec<Vec3>> = sets
+                    .iter()
+                    .map(|s| s.iter().map(|x| x.position).collect())
+                    .collect();
+                // Below 128 samples the plain loop is as fast (docs/benchmarks.md).
+                let n = sets[0].len() as u32;
+                match SampleGrid::build(&bounds, &per_set, n) {
+                    Some(sg) if !self.hard && n >= SampleGrid::MIN_SAMPLES => {
+                        let g = [sg.origin.x, sg.origin.y, sg.scale.x, sg.scale.y];
+                        grid = Some((sg.g, g));
+                        sg.data
+                    }
+                    _ => vec![0u32; 4],
+                }
+            }
         };
         let up = || -> Result<_, GpuError> {
             Ok((
@@ -437,6 +456,7 @@ impl Afsm {
             samples,
             radiance,
             lut,
+            grid,
             sample_positions,
         })
     }
@@ -526,6 +546,10 @@ impl Afsm {
         };
         p.bounds.write(&mut params);
         params.center = [p.bounds.center.x, p.bounds.center.y, p.bounds.center.z, 1.0];
+        if let Some((g, grid)) = p.grid {
+            params.options[2] = g;
+            params.grid = grid;
+        }
         if self.plane_test == PlaneTest::Lut {
             let b = crate::lut::bins_for(n);
             params.kind[3] = 1;

@@ -16,15 +16,23 @@ fn setup_view(name: &str, w: u32, h: u32) -> (SceneSetup, ViewSamples) {
     (setup, view)
 }
 
-/// Meshes over an 8 x 8 floor under a square light of side `light` at height `height`, seen
-/// from above at `w` x `h`.
-fn floor_scene(
-    meshes: Vec<MeshDesc>,
-    light: f32,
-    height: f32,
-    w: u32,
-    h: u32,
-) -> (SceneRef, Light, ViewSamples) {
+/// A square light of side `side` at height `height`, facing down.
+fn square_light(side: f32, height: f32) -> Light {
+    let radiance = Radiance::constant(glam::Vec3::ONE).unwrap();
+    Arc::new(
+        RectLight::facing(
+            glam::Vec3::Y * height,
+            glam::Vec3::NEG_Y,
+            side,
+            side,
+            radiance,
+        )
+        .unwrap(),
+    )
+}
+
+/// Meshes over an 8 x 8 floor, seen from above at `w` x `h`.
+fn floor_scene(meshes: Vec<MeshDesc>, w: u32, h: u32) -> (SceneRef, ViewSamples) {
     use glam::Vec3;
     let mut b = SceneBuilder::new();
     let f = shadow_core::procedural::floor(8.0, 0.0);
@@ -33,12 +41,9 @@ fn floor_scene(
         b.push_mesh(m).unwrap();
     }
     let scene: SceneRef = Arc::new(b.build().unwrap());
-    let radiance = Radiance::constant(Vec3::ONE).unwrap();
-    let light: Light =
-        Arc::new(RectLight::facing(Vec3::Y * height, Vec3::NEG_Y, light, light, radiance).unwrap());
     let cam = Camera::look_at(Vec3::new(0.0, 3.5, 3.0), Vec3::ZERO, Vec3::Y, 0.9).unwrap();
     let view = ViewSamples::render(scene.as_ref(), &cam, w, h).unwrap();
-    (scene, light, view)
+    (scene, view)
 }
 
 fn stratified_reference(setup: &SceneSetup, view: &ViewSamples) -> VisibilityImage {
@@ -164,7 +169,8 @@ fn silhouette_stencil_changes_no_bit_and_skips_umbra_work() {
         return;
     }
     let s = shadow_core::procedural::uv_sphere(glam::Vec3::new(0.0, 1.2, 0.0), 0.7, 24, 48);
-    let (scene, light, view) = floor_scene(vec![MeshDesc::new(s.0, s.1)], 0.3, 4.0, 48, 36);
+    let (scene, view) = floor_scene(vec![MeshDesc::new(s.0, s.1)], 48, 36);
+    let light = square_light(0.3, 4.0);
     assert!(scene.topology().components().iter().any(|c| c.closed));
     let run = |stencil: bool| {
         let mut a = Afsm::new(64, SamplingStrategy::Interleaved { tile: 2 }, 4).unwrap();
@@ -250,7 +256,8 @@ fn optical_depth_sums_saturate_instead_of_wrapping() {
             MeshDesc::new(q.0, q.1).with_opacity(opacity)
         })
         .collect();
-    let (scene, light, view) = floor_scene(panels, 0.5, 3.0, 32, 24);
+    let (scene, view) = floor_scene(panels, 32, 24);
+    let light = square_light(0.5, 3.0);
     let mut a = Afsm::new(32, SamplingStrategy::Correlated, 2).unwrap();
     a.prepare(scene.clone(), Arc::clone(&light)).unwrap();
     let est = a.estimate(&view).unwrap();
@@ -264,4 +271,35 @@ fn optical_depth_sums_saturate_instead_of_wrapping() {
     println!("umbra pixels {umbra}, {m:?}");
     assert!(umbra > 20);
     assert!(m.rmse < 1e-3 && m.max_abs < 1e-2, "{m:?}");
+}
+
+/// A polygon light (a tilted hexagon, no built-in scene has one) over a sphere: the bounding
+/// outline of section 4.1 and the sample grid on the polygon's plane, against the
+/// same-samples reference.
+#[test]
+fn polygon_light_agrees_with_the_same_samples_reference() {
+    if context_for_test("polygon_light_agrees_with_the_same_samples_reference").is_none() {
+        return;
+    }
+    use glam::Vec3;
+    let s = shadow_core::procedural::uv_sphere(Vec3::new(0.2, 1.0, 0.0), 0.5, 12, 24);
+    let (scene, view) = floor_scene(vec![MeshDesc::new(s.0, s.1)], 48, 36);
+    let outline: Vec<Vec3> = (0..6)
+        .map(|k| {
+            let a = k as f32 * std::f32::consts::TAU / 6.0;
+            Vec3::new(0.8 * a.cos(), 2.6 + 0.2 * a.cos(), 0.8 * a.sin())
+        })
+        .rev()
+        .collect();
+    let light: Light =
+        Arc::new(PolygonLight::new(outline, Radiance::constant(Vec3::ONE).unwrap()).unwrap());
+    let mut a = Afsm::new(256, SamplingStrategy::Interleaved { tile: 2 }, 9).unwrap();
+    a.prepare(scene.clone(), Arc::clone(&light)).unwrap();
+    let est = a.estimate(&view).unwrap();
+    let mut r = Reference::same_samples(a.light_sampler().unwrap().clone());
+    r.prepare(scene, light).unwrap();
+    let m = compare(&est.visibility, &r.estimate(&view).unwrap().visibility).unwrap();
+    println!("{m:?}");
+    assert!(m.sample_agreement.unwrap() >= 0.999, "{m:?}");
+    assert!(m.rmse < 0.004, "{m:?}");
 }

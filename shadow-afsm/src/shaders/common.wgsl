@@ -24,8 +24,11 @@ struct Params {
     // The occlusion work of one range of casters: first caster, caster count, tiles, chunks.
     work: vec4<u32>,
     // x = 1 when the silhouette stencil restricts per-sample work (section 4.3); y = 1 when
-    // semi-opaque casters accumulate per-sample optical depths.
+    // semi-opaque casters accumulate per-sample optical depths; z = buckets per side of the
+    // sample grid (0: none).
     options: vec4<u32>,
+    // The sample grid: origin (u, v) and buckets per unit (u, v) in the light's plane.
+    grid: vec4<f32>,
     // Up to 8 points bounding the light (rectangle corners, polygon outline or its box).
     outline: array<vec4<f32>, 8>,
 }

@@ -26,6 +26,8 @@
 @group(0) @binding(8) var<storage, read> samples: array<vec4<f32>>;
 @group(0) @binding(9) var<storage, read_write> masks: array<atomic<u32>>;
 @group(0) @binding(10) var<storage, read_write> stats: array<atomic<u32>>;
+// The plane table in LUT mode; in exact mode, the light samples bucketed on the light's plane
+// (`sample_grid.rs`): per set, g * g + 1 bucket offsets, then the sample indices.
 @group(0) @binding(11) var<storage, read> lut: array<u32>;
 @group(0) @binding(12) var<storage, read> flags: array<u32>;
 @group(0) @binding(13) var<storage, read_write> depths: array<atomic<u32>>;
@@ -186,6 +188,60 @@ fn occlude_pair(t: u32, i: u32, one: bool) -> u32 {
             }
             if bits != 0u {
                 hide(i, wd, bits, depth);
+            }
+        }
+        return 3u;
+    }
+    // Exact test. On a planar light, only the buckets under the bounding box of the triangle
+    // projected from o onto the light's plane can hold hidden samples (`sample_grid.rs`).
+    let g = P.options.z;
+    var bounded = g > 0u;
+    var box = vec4<u32>(0u);
+    if bounded {
+        let n = P.light_n.xyz;
+        let num = dot(P.center.xyz - o, n);
+        var lo = vec2<f32>(3.4e38);
+        var hi = vec2<f32>(-3.4e38);
+        let verts = array<vec3<f32>, 3>(a, b, c);
+        for (var k = 0u; k < 3u; k++) {
+            let den = dot(verts[k] - o, n);
+            // A vertex that does not project forward leaves the projection unbounded.
+            bounded = bounded && num * den > 0.0;
+            let q = o + (num / den) * (verts[k] - o) - P.center.xyz;
+            let uv = vec2<f32>(dot(q, P.light_u.xyz), dot(q, P.light_v.xyz));
+            lo = min(lo, uv);
+            hi = max(hi, uv);
+        }
+        // Padded by 1e-4 of the light's size against rounding.
+        let pad = 1e-4 * P.light_u.w;
+        let t0 = floor((lo - pad - P.grid.xy) * P.grid.zw);
+        let t1 = floor((hi + pad - P.grid.xy) * P.grid.zw);
+        let m = f32(g - 1u);
+        if bounded && (any(t1 < vec2<f32>(0.0)) || any(t0 > vec2<f32>(m))) {
+            // The projection misses every sample: nothing to hide.
+            return 3u;
+        }
+        box = vec4<u32>(vec2<u32>(clamp(t0, vec2<f32>(0.0), vec2<f32>(m))),
+                        vec2<u32>(clamp(t1, vec2<f32>(0.0), vec2<f32>(m))));
+        // Over half the buckets, the plain loop over every sample is cheaper.
+        bounded = bounded && 2u * (box.z - box.x + 1u) * (box.w - box.y + 1u) <= g * g;
+    }
+    if bounded {
+        var hidden: array<u32, 32>;
+        let cells = g * g;
+        let base = r.set_index * (cells + 1u + n_samples);
+        for (var by = box.y; by <= box.w; by++) {
+            let row = base + by * g;
+            for (var j = lut[row + box.x]; j < lut[row + box.z + 1u]; j++) {
+                let k = lut[base + cells + 1u + j];
+                if inside4(samples[first + k].xyz, &tm, &tb) {
+                    hidden[k / 32u] |= 1u << (k % 32u);
+                }
+            }
+        }
+        for (var wd = 0u; wd < words; wd++) {
+            if hidden[wd] != 0u {
+                hide(i, wd, hidden[wd], depth);
             }
         }
         return 3u;
