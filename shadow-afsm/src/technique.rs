@@ -121,10 +121,10 @@ fn group_receivers(
 
 /// The edges that can be a silhouette for some point of the light (section 4.3, after Laine et
 /// al. 2005, the paper's \[LAA*05\]), as degenerate casters `(a, b, b)` whose influence
-/// regions make the silhouette stencil: boundary
-/// and non-manifold edges always; a manifold edge unless the whole light lies on the same side
-/// of both faces (opposite sides when the faces disagree in orientation), where no light point
-/// sees one face from the front and the other from the back, and its faces' opacities agree.
+/// regions make the silhouette stencil. Boundary and non-manifold edges always count. A
+/// manifold edge counts unless its faces' opacities agree and the whole light lies on the same
+/// side of both faces (opposite sides when the faces disagree in orientation), where no light
+/// point sees one face from the front and the other from the back.
 pub fn silhouette_edges(scene: &dyn Scene, bounds: &LightBounds) -> Vec<Caster> {
     let topo = scene.topology();
     let positions = scene.positions();

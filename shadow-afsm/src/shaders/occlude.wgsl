@@ -14,9 +14,12 @@
 // triangle is a silhouette seen from o for part of the light. Pairs whose every plane is
 // dropped (umbra from this triangle) set the whole mask at once.
 //
-// Per-sample tests are exact (plane against sample), or, in LUT mode, the 3D lookup table of
-// section 4.2 returns the samples behind each plane from its two angles and distance, and the
-// masks of the planes are ANDed. Results combine across triangles with atomic OR.
+// Per-sample tests are exact (plane against sample; on planar lights only the samples bucketed
+// under the triangle's projection onto the light, see `sample_grid.rs`), or, in LUT mode, the
+// 3D lookup table of section 4.2 returns the samples behind each plane from its two angles and
+// distance, and the masks of the planes are ANDed. Off the silhouette stencil one sample
+// stands for all. Opaque casters combine with atomic OR; semi-opaque ones add their optical
+// depth to each hidden sample's sum (saturating).
 
 @group(0) @binding(0) var<uniform> P: Params;
 @group(0) @binding(4) var<storage, read> chunk_offsets: array<u32>;
