@@ -203,7 +203,13 @@ impl LightBounds {
         if hard {
             return Self::point(center);
         }
-        match light.geometry() {
+        let geometry = light.geometry();
+        let quad = || {
+            geometry
+                .bounding_quad()
+                .map_or_else(Vec::new, |q| q.to_vec())
+        };
+        match geometry {
             LightGeometry::Rectangle {
                 center,
                 half_u,
@@ -216,12 +222,7 @@ impl LightBounds {
                 axes: [half_u.normalize(), half_v.normalize()],
                 radius: 0.0,
                 bound: (half_u + half_v).length(),
-                outline: vec![
-                    center - half_u - half_v,
-                    center + half_u - half_v,
-                    center + half_u + half_v,
-                    center - half_u + half_v,
-                ],
+                outline: quad(),
             },
             LightGeometry::Disk {
                 center,
@@ -239,22 +240,11 @@ impl LightBounds {
             LightGeometry::Polygon { outline, normal } => {
                 let u = (outline[1] - outline[0]).normalize();
                 let axes = [u, normal.cross(u)];
+                // Up to 8 outline points, or the polygon's bounding rectangle.
                 let points = if outline.len() <= 8 {
                     outline.to_vec()
                 } else {
-                    // Its bounding rectangle in its plane.
-                    let (mut lo, mut hi) =
-                        (glam::Vec2::splat(f32::MAX), glam::Vec2::splat(f32::MIN));
-                    for p in outline {
-                        let q =
-                            glam::Vec2::new((*p - center).dot(axes[0]), (*p - center).dot(axes[1]));
-                        lo = lo.min(q);
-                        hi = hi.max(q);
-                    }
-                    [(lo.x, lo.y), (hi.x, lo.y), (hi.x, hi.y), (lo.x, hi.y)]
-                        .iter()
-                        .map(|&(x, y)| center + x * axes[0] + y * axes[1])
-                        .collect()
+                    quad()
                 };
                 let bound = points
                     .iter()

@@ -678,13 +678,7 @@ impl ShadowTechnique for Afsm {
 
     fn capabilities(&self) -> Capabilities {
         Capabilities {
-            lights: vec![
-                LightKind::Rectangle,
-                LightKind::Disk,
-                LightKind::Polygon,
-                LightKind::Sphere,
-                LightKind::Point,
-            ],
+            lights: LightKind::ALL.to_vec(),
             semi_opaque: true,
             textured_lights: true,
             needs_closed_meshes: false,

@@ -264,3 +264,49 @@ fn sample_counts_span_one_to_many() {
     assert!(out.iter().all(|x| x.position == Vec3::ONE));
     assert_eq!(p.area(), 0.0);
 }
+
+/// `bounding_quad`: a rectangle's own corners; a 12-gon (tilted) inside its quad, in the
+/// polygon's plane, touching every side; none for spheres.
+#[test]
+fn bounding_quads_hold_their_lights() {
+    let r = Radiance::constant(Vec3::ONE).unwrap();
+    let rect =
+        RectLight::facing(Vec3::new(0.0, 2.0, 0.0), Vec3::NEG_Y, 1.0, 0.5, r.clone()).unwrap();
+    let q = rect.geometry().bounding_quad().unwrap();
+    for c in q {
+        let d = c - Vec3::new(0.0, 2.0, 0.0);
+        assert!(
+            (d.x.abs() - 0.5).abs() < 1e-6 || (d.x.abs() - 0.25).abs() < 1e-6,
+            "{c}"
+        );
+        assert!(d.y.abs() < 1e-6);
+    }
+    let outline: Vec<Vec3> = (0..12)
+        .map(|k| {
+            let a = k as f32 * std::f32::consts::TAU / 12.0;
+            Vec3::new(a.cos(), 1.0 + 0.3 * a.cos(), a.sin())
+        })
+        .collect();
+    let poly = PolygonLight::new(outline.clone(), r.clone()).unwrap();
+    let q = poly.geometry().bounding_quad().unwrap();
+    let (e1, e2) = (q[1] - q[0], q[3] - q[0]);
+    assert!(e1.dot(e2).abs() < 1e-4, "a rectangle");
+    let n = e1.cross(e2).normalize();
+    let (mut lo, mut hi) = (glam::Vec2::splat(f32::MAX), glam::Vec2::splat(f32::MIN));
+    for p in &outline {
+        let d = *p - q[0];
+        assert!(d.dot(n).abs() < 1e-4, "in the plane");
+        let uv = glam::Vec2::new(
+            d.dot(e1) / e1.length_squared(),
+            d.dot(e2) / e2.length_squared(),
+        );
+        lo = lo.min(uv);
+        hi = hi.max(uv);
+    }
+    assert!(
+        lo.abs().max_element() < 1e-4 && (hi - 1.0).abs().max_element() < 1e-4,
+        "{lo} {hi}"
+    );
+    let sphere = SphereLight::new(Vec3::ZERO, 0.5, r).unwrap();
+    assert!(sphere.geometry().bounding_quad().is_none());
+}

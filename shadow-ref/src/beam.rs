@@ -7,8 +7,6 @@
 //! identical (a conservative cull, never an approximation).
 
 use glam::{Vec3, Vec3A};
-use shadow_core::geometry::orthonormal_basis;
-use shadow_core::light::LightGeometry;
 
 /// A pyramid (apex and a base quad), tested conservatively against boxes and triangles.
 #[derive(Debug, Clone, Copy)]
@@ -18,60 +16,6 @@ pub struct Beam {
     lo: Vec3A,
     hi: Vec3A,
     eps: f32,
-}
-
-/// The base quad of the beam for a planar light: its bounding rectangle in its own plane (the
-/// rectangle itself, the square around a disk, the bounding rectangle of a polygon). `None`
-/// for spheres and points.
-pub fn light_quad(geometry: &LightGeometry<'_>) -> Option<[Vec3; 4]> {
-    match *geometry {
-        LightGeometry::Rectangle {
-            center,
-            half_u,
-            half_v,
-            ..
-        } => Some([
-            center - half_u - half_v,
-            center + half_u - half_v,
-            center + half_u + half_v,
-            center - half_u + half_v,
-        ]),
-        LightGeometry::Disk {
-            center,
-            normal,
-            radius,
-        } => {
-            let (t, b) = orthonormal_basis(normal);
-            let (t, b) = (t * radius, b * radius);
-            Some([
-                center - t - b,
-                center + t - b,
-                center + t + b,
-                center - t + b,
-            ])
-        }
-        LightGeometry::Polygon { outline, normal } => {
-            let (t, b) = orthonormal_basis(normal);
-            let o = outline[0];
-            let (mut lo, mut hi) = (
-                glam::Vec2::splat(f32::INFINITY),
-                glam::Vec2::splat(f32::NEG_INFINITY),
-            );
-            for p in outline {
-                let l = glam::Vec2::new((*p - o).dot(t), (*p - o).dot(b));
-                lo = lo.min(l);
-                hi = hi.max(l);
-            }
-            let at = |x: f32, y: f32| o + t * x + b * y;
-            Some([
-                at(lo.x, lo.y),
-                at(hi.x, lo.y),
-                at(hi.x, hi.y),
-                at(lo.x, hi.y),
-            ])
-        }
-        LightGeometry::Sphere { .. } | LightGeometry::Point { .. } => None,
-    }
 }
 
 impl Beam {

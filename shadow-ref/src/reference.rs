@@ -32,7 +32,7 @@ use shadow_core::light::{LightKind, LightSample, PointLight};
 use shadow_core::prelude::*;
 use shadow_core::sampling::SamplingError;
 
-use crate::beam::{Beam, light_quad};
+use crate::beam::Beam;
 use crate::bvh::{BeamResult, OcclusionBvh};
 use crate::offset::RayOffset;
 
@@ -445,13 +445,7 @@ impl ShadowTechnique for Reference {
 
     fn capabilities(&self) -> Capabilities {
         Capabilities {
-            lights: vec![
-                LightKind::Rectangle,
-                LightKind::Disk,
-                LightKind::Polygon,
-                LightKind::Sphere,
-                LightKind::Point,
-            ],
+            lights: LightKind::ALL.to_vec(),
             semi_opaque: true,
             textured_lights: true,
             needs_closed_meshes: false,
@@ -493,7 +487,7 @@ impl ShadowTechnique for Reference {
         let quad = if self.source == SampleSource::Hard {
             None
         } else {
-            light_quad(&light.geometry())
+            light.geometry().bounding_quad()
         };
         self.prepared = Some(Prepared {
             quad,

@@ -134,6 +134,17 @@ pub enum LightKind {
     Point,
 }
 
+impl LightKind {
+    /// Every family, for techniques that take them all.
+    pub const ALL: [LightKind; 5] = [
+        LightKind::Rectangle,
+        LightKind::Disk,
+        LightKind::Polygon,
+        LightKind::Sphere,
+        LightKind::Point,
+    ];
+}
+
 impl LightGeometry<'_> {
     /// The family of this shape.
     pub fn kind(&self) -> LightKind {
@@ -143,6 +154,53 @@ impl LightGeometry<'_> {
             Self::Polygon { .. } => LightKind::Polygon,
             Self::Sphere { .. } => LightKind::Sphere,
             Self::Point { .. } => LightKind::Point,
+        }
+    }
+
+    /// A bounding rectangle of a planar light in its own plane, corners in order: the
+    /// rectangle itself, the square around a disk, the bounding rectangle of a polygon. `None`
+    /// for spheres and points.
+    pub fn bounding_quad(&self) -> Option<[Vec3; 4]> {
+        let quad = |o: Vec3, t: Vec3, b: Vec3, lo: glam::Vec2, hi: glam::Vec2| {
+            let at = |x: f32, y: f32| o + t * x + b * y;
+            [
+                at(lo.x, lo.y),
+                at(hi.x, lo.y),
+                at(hi.x, hi.y),
+                at(lo.x, hi.y),
+            ]
+        };
+        let (one, minus) = (glam::Vec2::ONE, -glam::Vec2::ONE);
+        match *self {
+            Self::Rectangle {
+                center,
+                half_u,
+                half_v,
+                ..
+            } => Some(quad(center, half_u, half_v, minus, one)),
+            Self::Disk {
+                center,
+                normal,
+                radius,
+            } => {
+                let (t, b) = crate::geometry::orthonormal_basis(normal);
+                Some(quad(center, t * radius, b * radius, minus, one))
+            }
+            Self::Polygon { outline, normal } => {
+                let (t, b) = crate::geometry::orthonormal_basis(normal);
+                let o = outline[0];
+                let (mut lo, mut hi) = (
+                    glam::Vec2::splat(f32::INFINITY),
+                    glam::Vec2::splat(f32::NEG_INFINITY),
+                );
+                for p in outline {
+                    let l = glam::Vec2::new((*p - o).dot(t), (*p - o).dot(b));
+                    lo = lo.min(l);
+                    hi = hi.max(l);
+                }
+                Some(quad(o, t, b, lo, hi))
+            }
+            Self::Sphere { .. } | Self::Point { .. } => None,
         }
     }
 
