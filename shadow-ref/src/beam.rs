@@ -6,7 +6,9 @@
 //! test on the candidates is the same watertight test as the single-ray path, so the answer is
 //! identical (a conservative cull, never an approximation).
 
-use glam::{Vec3, Vec3A};
+use glam::{Vec3, Vec3A, Vec4};
+
+use crate::watertight::Triangles4;
 
 /// A pyramid (apex and a base quad), tested conservatively against boxes and triangles.
 #[derive(Debug, Clone, Copy)]
@@ -16,6 +18,8 @@ pub struct Beam {
     lo: Vec3A,
     hi: Vec3A,
     eps: f32,
+    /// The same planes splatted for four-wide tests: `[nx, ny, nz, |nx|, |ny|, |nz|, d + eps]`.
+    wide: [[Vec4; 7]; 5],
 }
 
 impl Beam {
@@ -41,12 +45,60 @@ impl Beam {
         planes[4] = (n, n.dot(q[0]));
         let lo = q.iter().fold(a, |m, p| m.min(*p));
         let hi = q.iter().fold(a, |m, p| m.max(*p));
+        let wide = planes.map(|(n, d)| {
+            let m = n.abs();
+            [n.x, n.y, n.z, m.x, m.y, m.z, d + eps].map(Vec4::splat)
+        });
         Some(Self {
             planes,
             lo,
             hi,
             eps,
+            wide,
         })
+    }
+
+    /// [`Beam::box_outside`] for four boxes at once, given as `[min x, min y, min z, max x,
+    /// max y, max z]` with one box per lane: bit `i` is set when box `i` is outside. Empty boxes
+    /// (min `+inf`, max `-inf`) are outside.
+    #[inline]
+    pub fn boxes_outside4(&self, b: &[Vec4; 6]) -> u32 {
+        let mut out = 0;
+        for axis in 0..3 {
+            out |= b[axis]
+                .cmpgt(Vec4::splat(self.hi[axis] + self.eps))
+                .bitmask()
+                | b[axis + 3]
+                    .cmplt(Vec4::splat(self.lo[axis] - self.eps))
+                    .bitmask();
+        }
+        if out == 0xf {
+            return out;
+        }
+        let half = Vec4::splat(0.5);
+        let c = [0, 1, 2].map(|k| half * (b[k] + b[k + 3]));
+        let e = [0, 1, 2].map(|k| half * (b[k + 3] - b[k]));
+        for p in &self.wide {
+            let s =
+                p[0] * c[0] + p[1] * c[1] + p[2] * c[2] - (p[3] * e[0] + p[4] * e[1] + p[5] * e[2]);
+            out |= s.cmpgt(p[6]).bitmask();
+        }
+        out
+    }
+
+    /// [`Beam::triangle_outside`] for the four lanes of `t`: bit `i` is set when triangle `i`
+    /// lies entirely outside one face of the pyramid.
+    #[inline]
+    pub fn triangles_outside4(&self, t: &Triangles4) -> u32 {
+        let mut out = 0;
+        for p in &self.wide {
+            let side = |k: usize| {
+                let v = &t.v[k];
+                (p[0] * v[0] + p[1] * v[1] + p[2] * v[2]).cmpgt(p[6])
+            };
+            out |= (side(0) & side(1) & side(2)).bitmask();
+        }
+        out
     }
 
     /// True when the box `[min, max]` lies entirely outside the pyramid.
@@ -111,5 +163,63 @@ mod tests {
         ];
         assert!(beam.triangle_outside(&outside));
         assert!(Beam::new(Vec3::new(0.0, 2.0, 0.0), base, 1e-6).is_none());
+    }
+
+    #[test]
+    fn four_wide_tests_equal_the_scalar_tests() {
+        let base = [
+            Vec3::new(-1.0, 2.0, -0.5),
+            Vec3::new(1.0, 2.0, -0.5),
+            Vec3::new(1.0, 2.2, 0.5),
+            Vec3::new(-1.0, 2.2, 0.5),
+        ];
+        let beam = Beam::new(Vec3::new(0.1, 0.0, 0.2), base, 1e-6).unwrap();
+        let mut st = 11u64;
+        let mut r = || {
+            st = st
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((st >> 40) as f32) / (1u64 << 24) as f32 * 4.0 - 2.0
+        };
+        let (mut inside, mut outside) = (0, 0);
+        for _ in 0..2000 {
+            let boxes: Vec<(Vec3A, Vec3A)> = (0..4)
+                .map(|_| {
+                    let c = Vec3A::new(r(), r() + 1.0, r());
+                    let e = Vec3A::new(r().abs(), r().abs(), r().abs()) * 0.2;
+                    (c - e, c + e)
+                })
+                .collect();
+            let mut b = [Vec4::ZERO; 6];
+            for (lane, (lo, hi)) in boxes.iter().enumerate() {
+                for axis in 0..3 {
+                    b[axis][lane] = lo[axis];
+                    b[axis + 3][lane] = hi[axis];
+                }
+            }
+            let wide = beam.boxes_outside4(&b);
+            let tris: Vec<[Vec3A; 3]> = boxes
+                .iter()
+                .map(|(lo, hi)| [*lo, *hi, (*lo + *hi) * 0.5 + Vec3A::X * 0.1])
+                .collect();
+            let wide_t = beam.triangles_outside4(&Triangles4::pack(&tris));
+            for lane in 0..4 {
+                let scalar = beam.box_outside(boxes[lane].0, boxes[lane].1);
+                assert_eq!(wide & (1 << lane) != 0, scalar);
+                assert_eq!(
+                    wide_t & (1 << lane) != 0,
+                    beam.triangle_outside(&tris[lane])
+                );
+                if scalar {
+                    outside += 1;
+                } else {
+                    inside += 1;
+                }
+            }
+        }
+        assert!(inside > 500 && outside > 500, "{inside} {outside}");
+        // Empty boxes (min +inf, max -inf) are outside.
+        let inf = Vec4::splat(f32::INFINITY);
+        assert_eq!(beam.boxes_outside4(&[inf, inf, inf, -inf, -inf, -inf]), 0xf);
     }
 }

@@ -1,7 +1,13 @@
-//! The occlusion structure: an `obvhs` compressed wide BVH (CWBVH, Ylitie et al. 2017) over the
-//! scene's triangles, traversed with `ray_traverse_miss` for binary occlusion and
-//! `ray_traverse_anyhit` for the transmittance product through semi-opaque occluders, with the
-//! project's watertight triangle test.
+//! The occlusion structure. `obvhs` builds the tree (PLOC with reinsertion) and its compressed
+//! wide BVH (CWBVH, Ylitie et al. 2017); the queries are:
+//!
+//! * binary occlusion on the four-wide tree collapsed from the same BVH2 ([`crate::wide`]),
+//!   with the project's watertight triangle test four triangles at a time; the CWBVH's
+//!   `ray_traverse_miss` answers the same query ([`OcclusionBvh::occluded_cwbvh`], tested to
+//!   agree on every segment) and takes over when a tree is too deep for the four-wide stack;
+//! * the transmittance product through semi-opaque occluders with `ray_traverse_anyhit`;
+//! * beam culling: one traversal of the four-wide tree with a receiver's pyramid
+//!   ([`crate::beam`]) gives its candidate triangles, packed four to a test.
 //!
 //! Triangle boxes are padded by a relative epsilon before the build, so the float slab tests of
 //! the traversal cannot reject a ray that the exact triangle test would accept (flat boxes of
@@ -18,7 +24,8 @@ use obvhs::{Boundable, BvhBuildParams};
 use shadow_core::Scene;
 
 use crate::beam::Beam;
-use crate::watertight::ShearedRay;
+use crate::watertight::{ShearedRay, Triangles4};
+use crate::wide::Bvh4;
 
 #[derive(Clone, Copy)]
 struct PaddedTriangle {
@@ -38,20 +45,14 @@ pub struct OcclusionBvh {
     /// Triangles in BVH order (`primitive_indices` applied): three corners and the original id
     /// in one 64-byte record, so a leaf test touches one cache line.
     tris: Vec<BvhTriangle>,
-    /// The BVH2 the CWBVH was made from, for beam traversal.
-    beam_nodes: Vec<BeamNode>,
-    beam_prims: Vec<u32>,
+    /// The same tree collapsed to four children per node, for the single-ray occlusion query
+    /// (`None` when it cannot be represented; the CWBVH answers then), and the triangles in its
+    /// leaf order.
+    wide: Option<Bvh4>,
+    wide_leaves: Vec<WideLeaf>,
     /// Triangles and transmittances by scene id (candidate tests).
     by_id: Vec<[Vec3A; 3]>,
     transmittance_by_id: Vec<f32>,
-}
-
-#[derive(Clone, Copy)]
-struct BeamNode {
-    min: Vec3A,
-    max: Vec3A,
-    prim_count: u32,
-    first: u32,
 }
 
 /// What a beam traversal found for one receiver.
@@ -64,6 +65,60 @@ pub enum BeamResult {
     /// More candidates than the limit: use the per-segment BVH query.
     TooMany,
 }
+
+/// The candidate triangles of one beam, packed four to a [`Triangles4`] so each segment tests
+/// four at once; a partly filled last pack repeats its first triangle.
+#[derive(Debug, Clone, Default)]
+pub struct BeamCandidates {
+    packs: Vec<Triangles4>,
+    ids: Vec<u32>,
+}
+
+impl BeamCandidates {
+    /// Number of candidates.
+    pub fn len(&self) -> usize {
+        self.ids.len()
+    }
+
+    /// True when there are none.
+    pub fn is_empty(&self) -> bool {
+        self.ids.is_empty()
+    }
+
+    fn clear(&mut self) {
+        self.packs.clear();
+        self.ids.clear();
+    }
+
+    fn push(&mut self, tri: [Vec3A; 3], id: u32) {
+        let lane = self.ids.len() % 4;
+        if lane == 0 {
+            self.packs.push(Triangles4::pack(&[tri]));
+        } else if let Some(p) = self.packs.last_mut() {
+            p.set_lane(lane, tri);
+        }
+        self.ids.push(id);
+    }
+
+    /// Lanes of pack `k` that hold candidates.
+    fn valid(&self, k: usize) -> u32 {
+        let n = self.ids.len() - 4 * k;
+        if n >= 4 { 0xf } else { (1 << n) - 1 }
+    }
+}
+
+/// A leaf of the four-wide tree: its triangles for the four-wide test and their scene ids
+/// (padding lanes repeat the first triangle and its id).
+#[derive(Clone, Copy)]
+struct WideLeaf {
+    tris: Triangles4,
+    id: [u32; 4],
+    /// Lanes that hold triangles.
+    valid: u32,
+}
+
+/// Most triangles per leaf of the four-wide tree (measured: see `docs/benchmarks.md`).
+const WIDE_LEAF: usize = 4;
 
 #[derive(Clone, Copy)]
 #[repr(C, align(64))]
@@ -108,34 +163,39 @@ impl OcclusionBvh {
         );
         ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
         let bvh = bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false);
-        let beam_nodes = bvh2
-            .nodes
-            .iter()
-            .map(|n| BeamNode {
-                min: n.aabb.min,
-                max: n.aabb.max,
-                prim_count: n.prim_count,
-                first: n.first_index,
-            })
-            .collect::<Vec<_>>();
-        let beam_prims = bvh2.primitive_indices.clone();
+        let wide = Bvh4::collapse(&bvh2, WIDE_LEAF);
+        let record = |t: u32| BvhTriangle {
+            v: scene.triangle(t as usize).map(Vec3A::from),
+            id: t,
+        };
+        let wide_leaves = wide.as_ref().map_or_else(Vec::new, |w| {
+            w.leaves()
+                .map(|ids| {
+                    let tris: Vec<[Vec3A; 3]> = ids
+                        .iter()
+                        .map(|&t| scene.triangle(t as usize).map(Vec3A::from))
+                        .collect();
+                    let mut id = [ids[0]; 4];
+                    id[..ids.len()].copy_from_slice(ids);
+                    WideLeaf {
+                        tris: Triangles4::pack(&tris),
+                        id,
+                        valid: (1 << ids.len()) - 1,
+                    }
+                })
+                .collect()
+        });
         let by_id: Vec<[Vec3A; 3]> = (0..scene.triangle_count())
             .map(|t| scene.triangle(t).map(Vec3A::from))
             .collect();
         let transmittance_by_id: Vec<f32> = scene.opacities().iter().map(|o| 1.0 - o).collect();
         let ids = &bvh.primitive_indices;
-        let tris = ids
-            .iter()
-            .map(|&t| BvhTriangle {
-                v: scene.triangle(t as usize).map(Vec3A::from),
-                id: t,
-            })
-            .collect();
+        let tris = ids.iter().map(|&t| record(t)).collect();
         Self {
             bvh,
             tris,
-            beam_nodes,
-            beam_prims,
+            wide,
+            wide_leaves,
             by_id,
             transmittance_by_id,
         }
@@ -147,21 +207,19 @@ impl OcclusionBvh {
     }
 
     /// True when some triangle other than `ignore` (the receiver's own triangle, or
-    /// `u32::MAX`) lies strictly between `origin` and `origin + dir * t_max`.
+    /// `u32::MAX`) lies strictly between `origin` and `origin + dir * t_max`. Traverses the
+    /// four-wide tree ([`crate::wide`]) when there is one, else the CWBVH.
     pub fn occluded(&self, origin: Vec3, dir: Vec3, t_max: f32, ignore: u32) -> bool {
+        let mut last = u32::MAX;
+        self.occluded_cached(origin, dir, t_max, ignore, &mut last)
+    }
+
+    /// The same query on the `obvhs` CWBVH with `ray_traverse_miss`, whatever the four-wide
+    /// tree (for cross-checks and the benchmark).
+    pub fn occluded_cwbvh(&self, origin: Vec3, dir: Vec3, t_max: f32, ignore: u32) -> bool {
         let (o, d) = ray_parts(origin, dir);
         let sheared = ShearedRay::new(o, d);
-        let ray = Ray::new(o, d, 0.0, t_max);
-        !self.bvh.ray_traverse_miss(ray, |_, id| {
-            let tri = &self.tris[id];
-            if tri.id == ignore {
-                return f32::INFINITY;
-            }
-            let [a, b, c] = tri.v;
-            sheared
-                .intersect(a, b, c, 0.0, t_max)
-                .unwrap_or(f32::INFINITY)
-        })
+        self.cwbvh_blocker(&sheared, o, d, t_max, ignore).is_some()
     }
 
     /// The occlusion query with a shadow cache: `last` (a scene triangle id, or `u32::MAX`) is
@@ -183,9 +241,44 @@ impl OcclusionBvh {
                 return true;
             }
         }
+        let found = match &self.wide {
+            Some(w) => {
+                let mut found = None;
+                w.any_hit(o, d, t_max, |leaf| {
+                    let leaf = &self.wide_leaves[leaf];
+                    let mut hits = sheared.intersect4(&leaf.tris, t_max);
+                    while hits != 0 {
+                        let id = leaf.id[hits.trailing_zeros() as usize];
+                        hits &= hits - 1;
+                        if id != ignore {
+                            found = Some(id);
+                            return true;
+                        }
+                    }
+                    false
+                });
+                found
+            }
+            None => self.cwbvh_blocker(&sheared, o, d, t_max, ignore),
+        };
+        if let Some(id) = found {
+            *last = id;
+        }
+        found.is_some()
+    }
+
+    /// A triangle (scene id) blocking the segment, found on the CWBVH.
+    fn cwbvh_blocker(
+        &self,
+        sheared: &ShearedRay,
+        o: Vec3A,
+        d: Vec3A,
+        t_max: f32,
+        ignore: u32,
+    ) -> Option<u32> {
         let ray = Ray::new(o, d, 0.0, t_max);
-        let found = std::cell::Cell::new(u32::MAX);
-        let miss = self.bvh.ray_traverse_miss(ray, |_, id| {
+        let mut found = None;
+        self.bvh.ray_traverse_miss(ray, |_, id| {
             let tri = &self.tris[id];
             if tri.id == ignore {
                 return f32::INFINITY;
@@ -193,16 +286,13 @@ impl OcclusionBvh {
             let [a, b, c] = tri.v;
             match sheared.intersect(a, b, c, 0.0, t_max) {
                 Some(t) => {
-                    found.set(tri.id);
+                    found = Some(tri.id);
                     t
                 }
                 None => f32::INFINITY,
             }
         });
-        if !miss {
-            *last = found.get();
-        }
-        !miss
+        found
     }
 
     /// Product of `1 - opacity` over every distinct triangle strictly between `origin` and
@@ -231,47 +321,46 @@ impl OcclusionBvh {
         (t, hits.len() as u32)
     }
 
-    /// Collects into `out` the triangles (scene ids, `ignore` excepted) that may touch `beam`,
-    /// traversing the BVH2; stops at `limit` candidates.
+    /// Collects into `out` the triangles (`ignore` excepted) that may touch `beam`, traversing
+    /// the four-wide tree with four-wide box and triangle tests; stops at `limit` candidates.
+    /// Without a four-wide tree every beam is [`BeamResult::TooMany`] (the per-segment query on
+    /// the CWBVH answers).
     pub fn beam_candidates(
         &self,
         beam: &Beam,
         ignore: u32,
         limit: usize,
-        out: &mut Vec<u32>,
+        out: &mut BeamCandidates,
     ) -> BeamResult {
         out.clear();
-        if self.beam_nodes.is_empty() {
+        if self.tris.is_empty() {
             return BeamResult::Clear;
         }
-        let mut stack = [0u32; 64];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let node = &self.beam_nodes[stack[top] as usize];
-            if beam.box_outside(node.min, node.max) {
-                continue;
-            }
-            if node.prim_count > 0 {
-                for k in node.first..node.first + node.prim_count {
-                    let id = self.beam_prims[k as usize];
-                    if id != ignore && !beam.triangle_outside(&self.by_id[id as usize]) {
-                        if out.len() == limit {
-                            return BeamResult::TooMany;
-                        }
-                        out.push(id);
+        let Some(w) = &self.wide else {
+            return BeamResult::TooMany;
+        };
+        let complete = w.visit(
+            |b| beam.boxes_outside4(b),
+            |leaf| {
+                let leaf = &self.wide_leaves[leaf];
+                let mut keep = leaf.valid & !beam.triangles_outside4(&leaf.tris);
+                while keep != 0 {
+                    let lane = keep.trailing_zeros() as usize;
+                    keep &= keep - 1;
+                    if leaf.id[lane] == ignore {
+                        continue;
                     }
+                    if out.len() == limit {
+                        return false;
+                    }
+                    out.push(leaf.tris.lane(lane), leaf.id[lane]);
                 }
-            } else if top + 2 <= stack.len() {
-                stack[top] = node.first;
-                stack[top + 1] = node.first + 1;
-                top += 2;
-            } else {
-                // Deeper than the stack: give up on the beam, the per-segment query is exact.
-                return BeamResult::TooMany;
-            }
-        }
-        if out.is_empty() {
+                true
+            },
+        );
+        if !complete {
+            BeamResult::TooMany
+        } else if out.is_empty() {
             BeamResult::Clear
         } else {
             BeamResult::Candidates(out.len())
@@ -279,13 +368,19 @@ impl OcclusionBvh {
     }
 
     /// Segment test against a candidate list: true when one of them blocks it.
-    pub fn occluded_by(&self, candidates: &[u32], origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+    pub fn occluded_by(
+        &self,
+        candidates: &BeamCandidates,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+    ) -> bool {
         let (o, d) = ray_parts(origin, dir);
         let sheared = ShearedRay::new(o, d);
-        candidates.iter().any(|&id| {
-            let [a, b, c] = self.by_id[id as usize];
-            sheared.intersect(a, b, c, 0.0, t_max).is_some()
-        })
+        candidates
+            .packs
+            .iter()
+            .any(|p| sheared.intersect4(p, t_max) != 0)
     }
 
     /// Transmittance product over the candidates a segment crosses, and their count. The
@@ -293,21 +388,22 @@ impl OcclusionBvh {
     /// paths give bit-identical results.
     pub fn transmittance_by(
         &self,
-        candidates: &[u32],
+        candidates: &BeamCandidates,
         origin: Vec3,
         dir: Vec3,
         t_max: f32,
     ) -> (f32, u32) {
         let (o, d) = ray_parts(origin, dir);
         let sheared = ShearedRay::new(o, d);
-        let mut hits: Vec<u32> = candidates
-            .iter()
-            .copied()
-            .filter(|&id| {
-                let [a, b, c] = self.by_id[id as usize];
-                sheared.intersect(a, b, c, 0.0, t_max).is_some()
-            })
-            .collect();
+        let mut hits: Vec<u32> = Vec::new();
+        for (k, p) in candidates.packs.iter().enumerate() {
+            let mut m = sheared.intersect4(p, t_max) & candidates.valid(k);
+            while m != 0 {
+                let lane = m.trailing_zeros() as usize;
+                m &= m - 1;
+                hits.push(candidates.ids[4 * k + lane]);
+            }
+        }
         hits.sort_unstable();
         let t = hits.iter().fold(1.0f32, |acc, &id| {
             acc * self.transmittance_by_id[id as usize]

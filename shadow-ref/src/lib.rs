@@ -6,8 +6,11 @@
 //! point-light hard shadow.
 //!
 //! * [`beam`]: conservative beam culling of a receiver's segments to a planar light;
-//! * [`bvh`]: an `obvhs` CWBVH with occlusion (`ray_traverse_miss`) and any-hit queries;
-//! * [`watertight`]: the watertight ray-triangle test of Woop, Benthin and Wald (JCGT 2013);
+//! * [`bvh`]: the occlusion structure built by `obvhs` (PLOC, CWBVH) with occlusion, any-hit
+//!   and beam queries;
+//! * [`wide`]: the four-wide tree (SoA child boxes) the occlusion and beam queries traverse;
+//! * [`watertight`]: the watertight ray-triangle test of Woop, Benthin and Wald (JCGT 2013),
+//!   one triangle or four at a time;
 //! * [`offset`]: robust ray origins after Wachter and Binder (Ray Tracing Gems ch. 6);
 //! * [`mod@reference`]: the [`Reference`] technique.
 //!
@@ -31,6 +34,7 @@ pub mod offset;
 mod presets;
 pub mod reference;
 pub mod watertight;
+pub mod wide;
 
 pub use presets::presets;
 pub use reference::Reference;

@@ -33,7 +33,7 @@ use shadow_core::prelude::*;
 use shadow_core::sampling::SamplingError;
 
 use crate::beam::Beam;
-use crate::bvh::{BeamResult, OcclusionBvh};
+use crate::bvh::{BeamCandidates, BeamResult, OcclusionBvh};
 use crate::offset::RayOffset;
 
 /// Where the reference takes its light samples from.
@@ -56,7 +56,7 @@ const BEAM_CANDIDATES: usize = 16;
 #[derive(Default)]
 struct Scratch {
     vis: Vec<f32>,
-    candidates: Vec<u32>,
+    candidates: BeamCandidates,
 }
 
 /// What a receiver's beam found.

@@ -4,7 +4,7 @@
 //! f64 fallback when one is zero. A ray through an edge or vertex shared by two triangles hits
 //! at least one of them: no leak through closed meshes.
 
-use glam::{DVec3, Mat3A, Vec3A};
+use glam::{DVec3, Mat3A, Vec3A, Vec4};
 
 /// Per-ray constants of the test (section 3 of the paper). The permutation (`kx, ky, kz`) and
 /// the shear are folded into one matrix, so each vertex is transformed with one SIMD
@@ -15,6 +15,52 @@ pub struct ShearedRay {
     origin: Vec3A,
     /// Maps `v - origin` to `(v[kx] - sx v[kz], v[ky] - sy v[kz], sz v[kz])`.
     shear: Mat3A,
+    /// The permutation `[kx, ky, kz]` and `(sx, sy, sz)`, for the four-wide test.
+    axes: [usize; 3],
+    s: Vec3A,
+}
+
+/// Four triangles in structure-of-arrays form for [`ShearedRay::intersect4`]: `v[k][c]` holds
+/// coordinate `c` of vertex `k`, one lane per triangle. Unused lanes repeat a used triangle.
+#[derive(Debug, Clone, Copy)]
+pub struct Triangles4 {
+    /// Vertex, then coordinate, then lane.
+    pub v: [[Vec4; 3]; 3],
+}
+
+impl Triangles4 {
+    /// Packs one to four triangles; fewer than four are padded by repeating the first.
+    ///
+    /// # Panics
+    /// When `tris` is empty or longer than four.
+    pub fn pack(tris: &[[Vec3A; 3]]) -> Self {
+        assert!((1..=4).contains(&tris.len()), "one to four triangles");
+        let mut v = [[Vec4::ZERO; 3]; 3];
+        for lane in 0..4 {
+            let t = tris.get(lane).unwrap_or(&tris[0]);
+            for (k, vertex) in t.iter().enumerate() {
+                for c in 0..3 {
+                    v[k][c][lane] = vertex[c];
+                }
+            }
+        }
+        Self { v }
+    }
+
+    /// Writes `tri` into `lane`.
+    pub fn set_lane(&mut self, lane: usize, tri: [Vec3A; 3]) {
+        for (k, vertex) in tri.iter().enumerate() {
+            for c in 0..3 {
+                self.v[k][c][lane] = vertex[c];
+            }
+        }
+    }
+
+    /// The triangle in `lane`.
+    pub fn lane(&self, lane: usize) -> [Vec3A; 3] {
+        self.v
+            .map(|c| Vec3A::new(c[0][lane], c[1][lane], c[2][lane]))
+    }
 }
 
 impl ShearedRay {
@@ -42,7 +88,66 @@ impl ShearedRay {
         Self {
             origin,
             shear: Mat3A::from_cols(cols[0], cols[1], cols[2]),
+            axes: [kx, ky, kz],
+            s: Vec3A::new(sx, sy, sz),
         }
+    }
+
+    /// [`ShearedRay::intersect`] on four triangles at once with `t_min = 0`: bit `i` of the
+    /// result is set when lane `i` is hit with `0 < t < t_max`. Every lane computes exactly
+    /// the scalar test's operations (the same sheared coordinates and edge functions, in the
+    /// same order), so the answers are identical to four scalar calls; a lane with an edge
+    /// function at zero takes the scalar test and its double-precision fallback.
+    #[inline]
+    pub fn intersect4(&self, tris: &Triangles4, t_max: f32) -> u32 {
+        let [kx, ky, kz] = self.axes;
+        let o = [
+            Vec4::splat(self.origin.x),
+            Vec4::splat(self.origin.y),
+            Vec4::splat(self.origin.z),
+        ];
+        let (sx, sy, sz) = (
+            Vec4::splat(self.s.x),
+            Vec4::splat(self.s.y),
+            Vec4::splat(self.s.z),
+        );
+        let shear = |k: usize| {
+            let p = &tris.v[k];
+            let (x, y, z) = (p[kx] - o[kx], p[ky] - o[ky], p[kz] - o[kz]);
+            (x - sx * z, y - sy * z, sz * z)
+        };
+        let (ax, ay, az) = shear(0);
+        let (bx, by, bz) = shear(1);
+        let (cx, cy, cz) = shear(2);
+        let u = cx * by - cy * bx;
+        let v = ax * cy - ay * cx;
+        let w = bx * ay - by * ax;
+        let zero = Vec4::ZERO;
+        let on_edge = u.cmpeq(zero) | v.cmpeq(zero) | w.cmpeq(zero);
+        let neg = u.cmplt(zero) | v.cmplt(zero) | w.cmplt(zero);
+        let pos = u.cmpgt(zero) | v.cmpgt(zero) | w.cmpgt(zero);
+        let det = u + v + w;
+        let t_scaled = u * az + v * bz + w * cz;
+        let flip = det.cmplt(zero);
+        let (t_scaled, det) = (
+            Vec4::select(flip, -t_scaled, t_scaled),
+            Vec4::select(flip, -det, det),
+        );
+        let miss = (neg & pos)
+            | det.cmpeq(zero)
+            | t_scaled.cmple(zero)
+            | t_scaled.cmpge(Vec4::splat(t_max) * det);
+        let mut hit = (!(miss | on_edge)).bitmask();
+        let mut edge = on_edge.bitmask();
+        while edge != 0 {
+            let lane = edge.trailing_zeros() as usize;
+            edge &= edge - 1;
+            let [a, b, c] = tris.lane(lane);
+            if self.intersect(a, b, c, 0.0, t_max).is_some() {
+                hit |= 1 << lane;
+            }
+        }
+        hit
     }
 
     /// Ray parameter `t` (in units of the direction given to [`ShearedRay::new`]) of the hit with
@@ -172,5 +277,66 @@ mod tests {
             }
         }
         assert_eq!(rays, 60);
+    }
+
+    /// A small deterministic generator for the randomised checks.
+    fn lcg(state: &mut u64) -> f32 {
+        *state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((*state >> 40) as f32) / (1u64 << 24) as f32
+    }
+
+    #[test]
+    fn four_wide_test_equals_four_scalar_tests() {
+        let mut st = 7u64;
+        let r = |st: &mut u64, s: f32| (lcg(st) * 2.0 - 1.0) * s;
+        let mut hits = 0;
+        let mut edge_cases = 0;
+        for round in 0..4000 {
+            // Random triangles, and every tenth round a fan of triangles sharing vertices and
+            // edges on a lattice, hit by rays through lattice points (zero edge functions).
+            let tris: Vec<[Vec3A; 3]> = if round % 10 == 0 {
+                let c = Vec3A::new(r(&mut st, 1.0).round(), r(&mut st, 1.0).round(), 0.0);
+                (0..4)
+                    .map(|k| {
+                        let a = k as f32 * std::f32::consts::FRAC_PI_2;
+                        let p = c + Vec3A::new(a.cos().round(), a.sin().round(), 0.0);
+                        let q = c + Vec3A::new(-a.sin().round(), a.cos().round(), 0.0);
+                        [c, p, q]
+                    })
+                    .collect()
+            } else {
+                (0..1 + round % 4)
+                    .map(|_| {
+                        [0, 1, 2]
+                            .map(|_| Vec3A::new(r(&mut st, 2.0), r(&mut st, 2.0), r(&mut st, 2.0)))
+                    })
+                    .collect()
+            };
+            let target = if round % 10 == 0 {
+                edge_cases += 1;
+                tris[0][round / 10 % 3]
+            } else {
+                Vec3A::new(r(&mut st, 1.5), r(&mut st, 1.5), r(&mut st, 1.5))
+            };
+            let mut d = Vec3A::new(r(&mut st, 1.0), r(&mut st, 1.0), r(&mut st, 1.0));
+            if round % 7 == 0 {
+                d = Vec3A::new(0.0, 0.0, -1.0);
+            }
+            let Some(d) = d.try_normalize() else { continue };
+            let o = target - d * (1.0 + lcg(&mut st));
+            let ray = ShearedRay::new(o, d);
+            let pack = Triangles4::pack(&tris);
+            let t_max = 0.5 + 3.0 * lcg(&mut st);
+            let wide = ray.intersect4(&pack, t_max);
+            for lane in 0..4 {
+                let [a, b, c] = tris.get(lane).copied().unwrap_or(tris[0]);
+                let scalar = ray.intersect(a, b, c, 0.0, t_max).is_some();
+                assert_eq!(wide & (1 << lane) != 0, scalar, "round {round} lane {lane}");
+                hits += usize::from(scalar);
+            }
+        }
+        assert!(hits > 500 && edge_cases > 100, "{hits} {edge_cases}");
     }
 }

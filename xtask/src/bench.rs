@@ -386,9 +386,10 @@ pub fn run(a: BenchArgs) -> Result<(), String> {
     );
     let query = query_throughput(&bunny, &a, seed)?;
     println!(
-        "bunny, {} identical segments, one thread: single-ray query {:.2} M rays/s; reference trace with beam culling {:.2} M rays/s ({:.1}% occluded)",
+        "bunny, {} identical segments, one thread: single-ray query {:.2} M rays/s (four-wide tree; {:.2} M rays/s on the CWBVH); reference trace with beam culling {:.2} M rays/s ({:.1}% occluded)",
         query.rays,
         query.rays_per_second / 1e6,
+        query.cwbvh_rays_per_second / 1e6,
         query.reference_rays_per_second / 1e6,
         100.0 * query.occluded_share
     );
@@ -535,8 +536,10 @@ pub fn run(a: BenchArgs) -> Result<(), String> {
 #[derive(Debug, Clone, Serialize)]
 struct QueryThroughput {
     rays: usize,
-    /// The single-ray BVH query alone.
+    /// The single-ray BVH query alone (four-wide tree).
     rays_per_second: f64,
+    /// The same query on `obvhs`'s CWBVH.
+    cwbvh_rays_per_second: f64,
     /// The reference's trace phase (beam culling on) answering the same segments.
     reference_rays_per_second: f64,
     occluded_share: f64,
@@ -560,34 +563,49 @@ fn query_throughput(
         .num_threads(1)
         .build()
         .map_err(|e| e.to_string())?;
-    let (best, occluded, trace_best) = pool.install(|| -> Result<(f64, usize, f64), String> {
-        let mut best = f64::INFINITY;
-        let mut occluded = 0;
-        for _ in 0..=a.repeats {
-            let t0 = Instant::now();
-            occluded = segs
-                .iter()
-                .filter(|(o, d, t, tri)| bvh.occluded(*o, *d, *t, *tri))
-                .count();
-            best = best.min(t0.elapsed().as_secs_f64());
-        }
-        // The reference's whole trace phase (sampling, offsets, beam culling, queries) on the
-        // same view answers the same segments.
-        let mut trace_best = f64::INFINITY;
-        for _ in 0..=a.repeats {
-            let mut r = Reference::stratified(64, seed).map_err(|e| e.to_string())?;
-            let (e, _, _) = run_technique(&mut r, bunny, bunny.lights[0].clone(), &view)
-                .map_err(|e| e.to_string())?;
-            let secs = e
-                .stats
-                .phases
-                .iter()
-                .find(|p| p.name == "trace")
-                .map_or(f64::INFINITY, |p| p.seconds);
-            trace_best = trace_best.min(secs);
-        }
-        Ok((best, occluded, trace_best))
-    })?;
+    let (best, cwbvh_best, occluded, trace_best) =
+        pool.install(|| -> Result<(f64, f64, usize, f64), String> {
+            let mut best = f64::INFINITY;
+            let mut occluded = 0;
+            for _ in 0..=a.repeats {
+                let t0 = Instant::now();
+                occluded = segs
+                    .iter()
+                    .filter(|(o, d, t, tri)| bvh.occluded(*o, *d, *t, *tri))
+                    .count();
+                best = best.min(t0.elapsed().as_secs_f64());
+            }
+            let mut cwbvh_best = f64::INFINITY;
+            for _ in 0..=a.repeats {
+                let t0 = Instant::now();
+                let n = segs
+                    .iter()
+                    .filter(|(o, d, t, tri)| bvh.occluded_cwbvh(*o, *d, *t, *tri))
+                    .count();
+                cwbvh_best = cwbvh_best.min(t0.elapsed().as_secs_f64());
+                if n != occluded {
+                    return Err(format!(
+                        "CWBVH query: {n} occluded, four-wide tree: {occluded}"
+                    ));
+                }
+            }
+            // The reference's whole trace phase (sampling, offsets, beam culling, queries) on the
+            // same view answers the same segments.
+            let mut trace_best = f64::INFINITY;
+            for _ in 0..=a.repeats {
+                let mut r = Reference::stratified(64, seed).map_err(|e| e.to_string())?;
+                let (e, _, _) = run_technique(&mut r, bunny, bunny.lights[0].clone(), &view)
+                    .map_err(|e| e.to_string())?;
+                let secs = e
+                    .stats
+                    .phases
+                    .iter()
+                    .find(|p| p.name == "trace")
+                    .map_or(f64::INFINITY, |p| p.seconds);
+                trace_best = trace_best.min(secs);
+            }
+            Ok((best, cwbvh_best, occluded, trace_best))
+        })?;
     if a.export_rays {
         let mut rays = Vec::with_capacity(segs.len() * 28);
         for (o, d, t, _) in &segs {
@@ -614,6 +632,7 @@ fn query_throughput(
     Ok(QueryThroughput {
         rays: segs.len(),
         rays_per_second: segs.len() as f64 / best,
+        cwbvh_rays_per_second: segs.len() as f64 / cwbvh_best,
         reference_rays_per_second: segs.len() as f64 / trace_best,
         occluded_share: occluded as f64 / segs.len().max(1) as f64,
     })
