@@ -202,6 +202,7 @@ impl Bvh4 {
             // a blocked segment is usually answered by the first occluder it meets.
             let mut near = [(0.0f32, 0u32); 4];
             let mut inner = 0;
+            let entry = t0.to_array();
             while mask != 0 {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
@@ -212,7 +213,7 @@ impl Bvh4 {
                     }
                 } else {
                     // Insertion by decreasing entry distance.
-                    let t = t0[lane];
+                    let t = entry[lane];
                     let mut k = inner;
                     while k > 0 && near[k - 1].0 < t {
                         near[k] = near[k - 1];

@@ -60,6 +60,8 @@ pub struct SceneContext {
     pub view: ViewSamples,
     config: SuiteConfig,
     reference: OnceLock<Result<(VisibilityImage, f64), String>>,
+    /// The same scene at [`GPU_TEST_RESOLUTION`], for the extra checks of GPU presets.
+    small: OnceLock<Result<Box<SceneContext>, String>>,
 }
 
 impl SceneContext {
@@ -79,7 +81,34 @@ impl SceneContext {
             view,
             config,
             reference: OnceLock::new(),
+            small: OnceLock::new(),
         })
+    }
+
+    /// Where the determinism and convergence re-runs of a preset take place: this context, or
+    /// for a GPU preset run above [`GPU_TEST_RESOLUTION`] the same scene at that size. Those
+    /// checks compare a technique with itself and with the reference at two sample counts, so
+    /// they do not depend on the image size, and on a software adapter the three re-runs at full
+    /// size would be most of the main job's time.
+    ///
+    /// # Errors
+    /// A message when the smaller view cannot be rendered.
+    pub fn for_extra_checks(&self, processor: Processor) -> Result<&SceneContext, String> {
+        let (w, h) = GPU_TEST_RESOLUTION;
+        if processor != Processor::Gpu || self.config.width * self.config.height <= w * h {
+            return Ok(self);
+        }
+        self.small
+            .get_or_init(|| {
+                let config = SuiteConfig {
+                    width: w,
+                    height: h,
+                    ..self.config
+                };
+                SceneContext::new(self.setup.clone(), config).map(Box::new)
+            })
+            .as_deref()
+            .map_err(Clone::clone)
     }
 
     /// The light every case uses (the scene's first).
@@ -322,11 +351,38 @@ pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
     }
     let mut deterministic = None;
     let mut convergence = None;
-    if cfg.extra_checks {
+    let checks = if cfg.extra_checks {
+        match ctx.for_extra_checks(caps.processor) {
+            Ok(c) => Some(c),
+            Err(e) => {
+                violations.push(format!("extra checks: {e}"));
+                None
+            }
+        }
+    } else {
+        None
+    };
+    if let Some(ctx) = checks {
+        if ctx.config != cfg {
+            notes.push(format!(
+                "determinism and convergence checked at {}x{} (GPU preset)",
+                ctx.config.width, ctx.config.height
+            ));
+        }
+        // The first run at this size: the main run, or a run on the smaller view.
+        let first = if ctx.config == cfg {
+            Ok(est.visibility.coefficients().clone())
+        } else {
+            let mut t = (preset.make)(cfg.seed);
+            run_technique(t.as_mut(), &ctx.setup, ctx.light(), &ctx.view)
+                .map(|(e, _, _)| e.visibility.coefficients().clone())
+        };
         let mut again = (preset.make)(cfg.seed);
-        match run_technique(again.as_mut(), &ctx.setup, ctx.light(), &ctx.view) {
-            Ok((e2, _, _)) => {
-                let same_output = e2.visibility.coefficients() == est.visibility.coefficients();
+        match first.and_then(|first| {
+            run_technique(again.as_mut(), &ctx.setup, ctx.light(), &ctx.view).map(|r| (first, r))
+        }) {
+            Ok((first, (e2, _, _))) => {
+                let same_output = *e2.visibility.coefficients() == first;
                 if !same_output {
                     violations
                         .push("not deterministic: a second run with the same seed differs".into());
