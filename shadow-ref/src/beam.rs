@@ -86,11 +86,25 @@ impl Beam {
         out
     }
 
-    /// [`Beam::triangle_outside`] for the four lanes of `t`: bit `i` is set when triangle `i`
-    /// lies entirely outside one face of the pyramid.
+    /// [`Beam::triangle_outside`] for the four lanes of `t`, and the test of each triangle's
+    /// bounding box against the pyramid's (a leaf's box may reach the beam while some of its
+    /// triangles cannot, like the receiver's own floor below the apex): bit `i` is set when
+    /// triangle `i` is outside.
     #[inline]
     pub fn triangles_outside4(&self, t: &Triangles4) -> u32 {
         let mut out = 0;
+        for axis in 0..3 {
+            let (a, b, c) = (t.v[0][axis], t.v[1][axis], t.v[2][axis]);
+            out |= a
+                .min(b)
+                .min(c)
+                .cmpgt(Vec4::splat(self.hi[axis] + self.eps))
+                .bitmask()
+                | a.max(b)
+                    .max(c)
+                    .cmplt(Vec4::splat(self.lo[axis] - self.eps))
+                    .bitmask();
+        }
         for p in &self.wide {
             let side = |k: usize| {
                 let v = &t.v[k];
@@ -116,12 +130,17 @@ impl Beam {
             .any(|(n, d)| n.dot(c) - n.abs().dot(e) > d + self.eps)
     }
 
-    /// True when the triangle lies entirely outside one face of the pyramid.
+    /// True when the triangle lies entirely outside one face of the pyramid or its bounding
+    /// box outside the pyramid's.
     #[inline]
     pub fn triangle_outside(&self, v: &[Vec3A; 3]) -> bool {
-        self.planes
-            .iter()
-            .any(|(n, d)| v.iter().all(|p| n.dot(*p) > d + self.eps))
+        let (lo, hi) = (v[0].min(v[1]).min(v[2]), v[0].max(v[1]).max(v[2]));
+        lo.cmpgt(self.hi + Vec3A::splat(self.eps)).any()
+            || hi.cmplt(self.lo - Vec3A::splat(self.eps)).any()
+            || self
+                .planes
+                .iter()
+                .any(|(n, d)| v.iter().all(|p| n.dot(*p) > d + self.eps))
     }
 }
 

@@ -179,11 +179,19 @@ impl Bvh4 {
             Vec4::splat(origin.z),
         );
         let (ix, iy, iz) = (Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z));
+        // The far distances use the inverse widened by `FAR_WIDEN` (the same bound as widening
+        // each far distance, one product fewer per node).
+        let wide = inv * FAR_WIDEN;
+        let (jx, jy, jz) = (
+            Vec4::splat(wide.x),
+            Vec4::splat(wide.y),
+            Vec4::splat(wide.z),
+        );
         // Near and far bound of each axis by the direction's sign.
         let near = |a: usize, i: f32| if i >= 0.0 { a } else { a + 3 };
         let (nx, ny, nz) = (near(0, inv.x), near(1, inv.y), near(2, inv.z));
         let (fx, fy, fz) = ((nx + 3) % 6, (ny + 3) % 6, (nz + 3) % 6);
-        let t_far = Vec4::splat(t_max);
+        let t_far = Vec4::splat(t_max * FAR_WIDEN);
         let mut stack = Stack::new();
         stack.push(0);
         while let Some(n) = stack.pop() {
@@ -193,11 +201,11 @@ impl Bvh4 {
                 .max((b[ny] - oy) * iy)
                 .max((b[nz] - oz) * iz)
                 .max(Vec4::ZERO);
-            let t1 = ((b[fx] - ox) * ix)
-                .min((b[fy] - oy) * iy)
-                .min((b[fz] - oz) * iz)
+            let t1 = ((b[fx] - ox) * jx)
+                .min((b[fy] - oy) * jy)
+                .min((b[fz] - oz) * jz)
                 .min(t_far);
-            let mut mask = t0.cmple(t1 * FAR_WIDEN).bitmask();
+            let mut mask = t0.cmple(t1).bitmask();
             // Inner children go on the stack farthest first, so the nearest is visited next:
             // a blocked segment is usually answered by the first occluder it meets.
             let mut near = [(0.0f32, 0u32); 4];

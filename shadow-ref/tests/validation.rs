@@ -567,3 +567,19 @@ fn four_wide_tree_equals_the_cwbvh() {
         assert!(blocked > 0, "{name}: nothing blocked");
     }
 }
+
+#[test]
+fn beams_prove_lit_receivers_clear() {
+    // On `quad-over-plane` most floor receivers see the whole light past the occluder: their
+    // beams must come out clear, with no ray cast, even though a leaf of the tree holds the
+    // floor's triangles together with the occluder's (each triangle's own box is tested).
+    let setup = builtin("quad-over-plane").unwrap();
+    let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera.unwrap(), 32, 24).unwrap();
+    let mut r = Reference::stratified(64, 1).unwrap();
+    r.prepare(setup.scene.clone(), setup.lights[0].clone())
+        .unwrap();
+    let est = r.estimate(&view).unwrap();
+    let clear = est.stats.counter("pixels-beam-clear");
+    let pixels = est.stats.counter("pixels");
+    assert!(2 * clear > pixels, "{clear} clear beams of {pixels} pixels");
+}
