@@ -3,7 +3,7 @@
 //!     cargo run --release -p shadow-ref --example query_bench -- [SCENE] [WIDTH] [HEIGHT]
 //!
 //! Prints rays per second on one thread for the reference's trace phase answering the segments
-//! (best of eight) and for the single-ray query alone on the four-wide tree and on the `obvhs`
+//! (best of eight) and for the single-ray query alone on the wide tree and on the `obvhs`
 //! CWBVH (best of six), and fails when the two queries' answers differ on any segment.
 
 use std::time::Instant;
@@ -57,7 +57,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .filter(|s| bvh.occluded(s.0, s.1, s.2, s.3) != bvh.occluded_cwbvh(s.0, s.1, s.2, s.3))
         .count();
     println!(
-        "{scene} {w}x{h}: {} segments, {:.1}% blocked; reference trace {:.2} M rays/s; single-ray query: four-wide {wide:.2} M rays/s, CWBVH {cw:.2} M rays/s ({:.2}x); {differ} answers differ",
+        "{scene} {w}x{h}: {} segments, {:.1}% blocked; reference trace {:.2} M rays/s; single-ray query: wide tree {wide:.2} M rays/s, CWBVH {cw:.2} M rays/s ({:.2}x); {differ} answers differ",
         segs.len(),
         100.0 * wb as f64 / segs.len().max(1) as f64,
         segs.len() as f64 / trace / 1e6,

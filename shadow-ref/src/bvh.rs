@@ -1,12 +1,13 @@
 //! The occlusion structure. `obvhs` builds the tree (PLOC with reinsertion) and its compressed
 //! wide BVH (CWBVH, Ylitie et al. 2017); the queries are:
 //!
-//! * binary occlusion on the four-wide tree collapsed from the same BVH2 ([`crate::wide`]),
+//! * binary occlusion on the wide tree (sixteen children per node) collapsed from the same
+//!   BVH2 ([`crate::wide`]),
 //!   with the project's watertight triangle test four triangles at a time; the CWBVH's
 //!   `ray_traverse_miss` answers the same query ([`OcclusionBvh::occluded_cwbvh`], tested to
-//!   agree on every segment) and takes over when a tree is too deep for the four-wide stack;
+//!   agree on every segment) and takes over when a tree is too deep for the wide tree's stack;
 //! * the transmittance product through semi-opaque occluders with `ray_traverse_anyhit`;
-//! * beam culling: one traversal of the four-wide tree with a receiver's pyramid
+//! * beam culling: one traversal of the wide tree with a receiver's pyramid
 //!   ([`crate::beam`]) gives its candidate triangles, packed four to a test.
 //!
 //! Triangle boxes are padded by a relative epsilon before the build, so the float slab tests of
@@ -25,7 +26,7 @@ use shadow_core::Scene;
 
 use crate::beam::Beam;
 use crate::watertight::{ShearedRay, Triangles4};
-use crate::wide::Bvh4;
+use crate::wide::WideBvh;
 
 #[derive(Clone, Copy)]
 struct PaddedTriangle {
@@ -48,7 +49,7 @@ pub struct OcclusionBvh {
     /// The same tree collapsed to four children per node, for the single-ray occlusion query
     /// (`None` when it cannot be represented; the CWBVH answers then), and the triangles in its
     /// leaf order.
-    wide: Option<Bvh4>,
+    wide: Option<WideBvh>,
     wide_leaves: Vec<WideLeaf>,
     /// Triangles and transmittances by scene id (candidate tests).
     by_id: Vec<[Vec3A; 3]>,
@@ -107,7 +108,7 @@ impl BeamCandidates {
     }
 }
 
-/// A leaf of the four-wide tree: its triangles for the four-wide test and their scene ids
+/// A leaf of the wide tree: its triangles for the four-triangle test and their scene ids
 /// (padding lanes repeat the first triangle and its id).
 #[derive(Clone, Copy)]
 struct WideLeaf {
@@ -117,7 +118,7 @@ struct WideLeaf {
     valid: u32,
 }
 
-/// Most triangles per leaf of the four-wide tree (measured: see `docs/benchmarks.md`).
+/// Most triangles per leaf of the wide tree (measured: see `docs/benchmarks.md`).
 const WIDE_LEAF: usize = 4;
 
 #[derive(Clone, Copy)]
@@ -163,7 +164,7 @@ impl OcclusionBvh {
         );
         ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
         let bvh = bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false);
-        let wide = Bvh4::collapse(&bvh2, WIDE_LEAF);
+        let wide = WideBvh::collapse(&bvh2, WIDE_LEAF);
         let record = |t: u32| BvhTriangle {
             v: scene.triangle(t as usize).map(Vec3A::from),
             id: t,
@@ -208,14 +209,13 @@ impl OcclusionBvh {
 
     /// True when some triangle other than `ignore` (the receiver's own triangle, or
     /// `u32::MAX`) lies strictly between `origin` and `origin + dir * t_max`. Traverses the
-    /// four-wide tree ([`crate::wide`]) when there is one, else the CWBVH.
+    /// wide tree ([`crate::wide`]) when there is one, else the CWBVH.
     pub fn occluded(&self, origin: Vec3, dir: Vec3, t_max: f32, ignore: u32) -> bool {
         let mut last = u32::MAX;
         self.occluded_cached(origin, dir, t_max, ignore, &mut last)
     }
 
-    /// The same query on the `obvhs` CWBVH with `ray_traverse_miss`, whatever the four-wide
-    /// tree (for cross-checks and the benchmark).
+    /// The same query on the `obvhs` CWBVH with `ray_traverse_miss`, whatever the wide tree (for cross-checks and the benchmark).
     pub fn occluded_cwbvh(&self, origin: Vec3, dir: Vec3, t_max: f32, ignore: u32) -> bool {
         let (o, d) = ray_parts(origin, dir);
         let sheared = ShearedRay::new(o, d);
@@ -322,8 +322,8 @@ impl OcclusionBvh {
     }
 
     /// Collects into `out` the triangles (`ignore` excepted) that may touch `beam`, traversing
-    /// the four-wide tree with four-wide box and triangle tests; stops at `limit` candidates.
-    /// Without a four-wide tree every beam is [`BeamResult::TooMany`] (the per-segment query on
+    /// the wide tree with four-wide box and triangle tests; stops at `limit` candidates.
+    /// Without a wide tree every beam is [`BeamResult::TooMany`] (the per-segment query on
     /// the CWBVH answers).
     pub fn beam_candidates(
         &self,

@@ -8,7 +8,8 @@
 //! * [`beam`]: conservative beam culling of a receiver's segments to a planar light;
 //! * [`bvh`]: the occlusion structure built by `obvhs` (PLOC, CWBVH) with occlusion, any-hit
 //!   and beam queries;
-//! * [`wide`]: the four-wide tree (SoA child boxes) the occlusion and beam queries traverse;
+//! * [`wide`]: the wide tree (sixteen SoA child boxes per node) the occlusion and beam queries
+//!   traverse;
 //! * [`watertight`]: the watertight ray-triangle test of Woop, Benthin and Wald (JCGT 2013),
 //!   one triangle or four at a time;
 //! * [`offset`]: robust ray origins after Wachter and Binder (Ray Tracing Gems ch. 6);

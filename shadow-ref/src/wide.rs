@@ -1,20 +1,23 @@
-//! A four-wide BVH (BVH4) for the single-ray occlusion query, collapsed from the `obvhs` BVH2
-//! the reference builds (PLOC with reinsertion), so the tree quality is `obvhs`'s and only the
-//! traversal is the project's own.
+//! A wide BVH for the single-ray occlusion query and beam culling: sixteen children per node,
+//! in four SIMD groups of four, collapsed from the `obvhs` BVH2 the reference builds (PLOC with
+//! reinsertion), so the tree quality is `obvhs`'s and only the layout and traversal are the
+//! project's own.
 //!
 //! Why a second layout: `obvhs`'s CWBVH (Ylitie, Karras and Laine, HPG 2017) stores child boxes
 //! quantised to 8 bits, which suits a GPU's memory bandwidth; on a CPU every visited node is
-//! decoded first. Here a node holds its four children's boxes uncompressed, one SIMD lane per
-//! child (structure of arrays), so one node test is six subtractions, six products and the
-//! min/max reductions, four children at a time (SSE2 through `glam::Vec4`, scalar elsewhere).
-//! The layout is the one of Wald et al., "Embree: A Kernel Framework for Efficient CPU Ray
-//! Tracing" (SIGGRAPH 2014), section 4 (BVH4 with SoA child bounds).
+//! decoded first. Here a node holds its children's boxes uncompressed, one SIMD lane per child
+//! (structure of arrays, as in Wald et al., "Embree: A Kernel Framework for Efficient CPU Ray
+//! Tracing", SIGGRAPH 2014, section 4), so one group test is six subtractions, six products and
+//! the min/max reductions, four children at a time (SSE2 through `glam::Vec4`, scalar
+//! elsewhere). Sixteen children per node, as in the multi-branching BVHs of Wald, Benthin and
+//! Boulos, "Getting Rid of Packets" (RT 2008), make the tree shallow, so a segment visits few
+//! nodes and a beam few levels (measured against four and eight: see `docs/benchmarks.md`).
 //!
 //! Robustness: the slab distances use `(bound - origin) * inverse`, and the far distance is
-//! widened by a few ulps before the comparison (Ize, "Robust BVH Ray Traversal", JCGT 2(2),
-//! 2013), over triangle boxes already padded at the build. A box test can therefore only accept
-//! too much, never reject a box the exact triangle test needs; the answer is decided by the
-//! watertight triangle test alone, the same as on the CWBVH path (tested to agree exactly).
+//! widened by a few ulps (Ize, "Robust BVH Ray Traversal", JCGT 2(2), 2013), over triangle boxes
+//! already padded at the build. A box test can therefore only accept too much, never reject a
+//! box the exact triangle test needs; the answer is decided by the watertight triangle test
+//! alone, the same as on the CWBVH path (tested to agree exactly).
 
 use glam::{Vec3A, Vec4};
 use obvhs::bvh2::Bvh2;
@@ -23,39 +26,44 @@ use obvhs::bvh2::Bvh2;
 const LEAF: u32 = 1 << 31;
 /// An empty child slot (its box is empty too).
 const EMPTY: u32 = u32::MAX;
-/// Most primitives in one leaf: one four-wide triangle test.
+/// Most primitives in one leaf: one four-triangle test.
 pub const MAX_LEAF: usize = 4;
 /// Traversal stack entries; a tree deeper than this allows is not built (the CWBVH answers).
-const STACK: usize = 256;
+const STACK: usize = 1024;
 /// Relative widening of the far slab distance: `1 + 2 gamma(3)` of Ize's bound, rounded up.
 const FAR_WIDEN: f32 = 1.0 + 8.0 * f32::EPSILON;
 
-/// One node: the boxes of four children, one lane each, and the children.
+/// Groups of four children per node.
+const HALVES: usize = 4;
+/// Children per node.
+const WIDTH: usize = 4 * HALVES;
+
+/// One node: the boxes of its children, four to a group, one lane each, and the children.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-struct Node4 {
-    /// `[min x, min y, min z, max x, max y, max z]`, each over the four children.
-    bounds: [Vec4; 6],
+struct WideNode {
+    /// Per group, `[min x, min y, min z, max x, max y, max z]` over its four children.
+    bounds: [[Vec4; 6]; HALVES],
     /// Inner child: node index. Leaf child: [`LEAF`] and the leaf number. Empty slots have an
     /// empty box and are never visited.
-    child: [u32; 4],
+    child: [u32; WIDTH],
 }
 
 /// The collapsed tree: nodes and its leaves' primitives.
 #[derive(Debug, Clone)]
-pub struct Bvh4 {
-    nodes: Vec<Node4>,
+pub struct WideBvh {
+    nodes: Vec<WideNode>,
     /// Primitive (input) indices in leaf order: a leaf's primitives are contiguous.
     order: Vec<u32>,
     /// Each leaf's range in `order`.
     leaves: Vec<std::ops::Range<u32>>,
 }
 
-impl Bvh4 {
-    /// Collapses `bvh2` into a four-wide tree whose leaves hold at most `max_leaf` primitives
+impl WideBvh {
+    /// Collapses `bvh2` into a wide tree whose leaves hold at most `max_leaf` primitives
     /// (a BVH2 subtree with that many or fewer becomes one leaf). Each node takes the two
     /// children of its BVH2 node and keeps opening the child with the largest surface area
-    /// until it has four (the usual greedy collapse, Wald et al. 2008). `None` when the tree
+    /// until it has sixteen (the greedy collapse of Wald, Benthin and Boulos 2008). `None` when the tree
     /// cannot be represented (a BVH2 leaf with more than [`MAX_LEAF`] primitives, 2^31
     /// leaves or more, or deeper than the traversal stack allows).
     pub fn collapse(bvh2: &Bvh2, max_leaf: usize) -> Option<Self> {
@@ -76,15 +84,17 @@ impl Bvh4 {
         let mut work = vec![(0usize, 0usize, 1usize)];
         out.nodes.push(empty_node());
         let mut depth = 1;
+        let mut scratch = Vec::new();
         while let Some((n2, slot, d)) = work.pop() {
             depth = depth.max(d);
-            let mut kids: Vec<usize> = if is_leaf(n2) {
-                vec![n2]
+            let mut kids = arrayvec::ArrayVec::<usize, WIDTH>::new();
+            if is_leaf(n2) {
+                kids.push(n2);
             } else {
                 let f = nodes2[n2].first_index as usize;
-                vec![f, f + 1]
-            };
-            while kids.len() < 4 {
+                kids.extend([f, f + 1]);
+            }
+            while kids.len() < WIDTH {
                 let open = kids
                     .iter()
                     .enumerate()
@@ -102,12 +112,13 @@ impl Bvh4 {
             }
             for (lane, &k) in kids.iter().enumerate() {
                 let b = &nodes2[k].aabb;
+                let (h, l) = (lane / 4, lane % 4);
                 for axis in 0..3 {
-                    out.nodes[slot].bounds[axis][lane] = b.min[axis];
-                    out.nodes[slot].bounds[axis + 3][lane] = b.max[axis];
+                    out.nodes[slot].bounds[h][axis][l] = b.min[axis];
+                    out.nodes[slot].bounds[h][axis + 3][l] = b.max[axis];
                 }
                 out.nodes[slot].child[lane] = if is_leaf(k) {
-                    out.leaf(bvh2, k)?
+                    out.leaf(bvh2, k, &mut scratch)?
                 } else {
                     out.nodes.push(empty_node());
                     let child = out.nodes.len() - 1;
@@ -116,16 +127,18 @@ impl Bvh4 {
                 };
             }
         }
-        if 3 * depth + 4 > STACK {
+        if (WIDTH - 1) * depth + WIDTH > STACK {
             return None;
         }
         Some(out)
     }
 
-    /// Appends the primitives of BVH2 subtree `n2` as a new leaf; the leaf child code.
-    fn leaf(&mut self, bvh2: &Bvh2, n2: usize) -> Option<u32> {
+    /// Appends the primitives of BVH2 subtree `n2` as a new leaf; the leaf child code. `stack`
+    /// is scratch space.
+    fn leaf(&mut self, bvh2: &Bvh2, n2: usize, stack: &mut Vec<usize>) -> Option<u32> {
         let first = self.order.len();
-        let mut stack = vec![n2];
+        stack.clear();
+        stack.push(n2);
         while let Some(i) = stack.pop() {
             let n = &bvh2.nodes[i];
             if n.prim_count > 0 {
@@ -160,7 +173,7 @@ impl Bvh4 {
     }
 
     /// Visits the leaves whose boxes the segment `origin + t dir`, `0 <= t <= t_max`, may touch,
-    /// calling `test` with each leaf's number (as in [`Bvh4::leaves`]) until it returns true. Returns true when it did (the segment is blocked). `dir` must be finite and
+    /// calling `test` with each leaf's number (as in [`WideBvh::leaves`]) until it returns true. Returns true when it did (the segment is blocked). `dir` must be finite and
     /// non-zero; negative zeros are harmless.
     #[inline]
     pub fn any_hit(
@@ -196,21 +209,24 @@ impl Bvh4 {
         stack.push(0);
         while let Some(n) = stack.pop() {
             let node = &self.nodes[n as usize];
-            let b = &node.bounds;
-            let t0 = ((b[nx] - ox) * ix)
-                .max((b[ny] - oy) * iy)
-                .max((b[nz] - oz) * iz)
-                .max(Vec4::ZERO);
-            let t1 = ((b[fx] - ox) * jx)
-                .min((b[fy] - oy) * jy)
-                .min((b[fz] - oz) * jz)
-                .min(t_far);
-            let mut mask = t0.cmple(t1).bitmask();
+            let mut mask = 0u32;
+            let mut entry = [0.0f32; WIDTH];
+            for (h, b) in node.bounds.iter().enumerate() {
+                let t0 = ((b[nx] - ox) * ix)
+                    .max((b[ny] - oy) * iy)
+                    .max((b[nz] - oz) * iz)
+                    .max(Vec4::ZERO);
+                let t1 = ((b[fx] - ox) * jx)
+                    .min((b[fy] - oy) * jy)
+                    .min((b[fz] - oz) * jz)
+                    .min(t_far);
+                mask |= t0.cmple(t1).bitmask() << (4 * h);
+                entry[4 * h..4 * h + 4].copy_from_slice(&t0.to_array());
+            }
             // Inner children go on the stack farthest first, so the nearest is visited next:
             // a blocked segment is usually answered by the first occluder it meets.
-            let mut near = [(0.0f32, 0u32); 4];
+            let mut near = [(0.0f32, 0u32); WIDTH];
             let mut inner = 0;
-            let entry = t0.to_array();
             while mask != 0 {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
@@ -239,10 +255,10 @@ impl Bvh4 {
     }
 }
 
-impl Bvh4 {
+impl WideBvh {
     /// Visits the leaves of every child box that `outside` does not reject: `outside` gets a
-    /// node's four child boxes (`[min x, min y, min z, max x, max y, max z]`, one lane each)
-    /// and returns a bit mask of the children to skip; `leaf` gets a leaf's number and returns
+    /// group of four child boxes of a node (`[min x, min y, min z, max x, max y, max z]`, one
+    /// lane each) and returns a bit mask of those to skip; `leaf` gets a leaf's number and returns
     /// false to stop. Returns false when `leaf` stopped the traversal.
     pub fn visit(
         &self,
@@ -253,7 +269,10 @@ impl Bvh4 {
         stack.push(0);
         while let Some(n) = stack.pop() {
             let node = &self.nodes[n as usize];
-            let mut mask = !outside(&node.bounds) & 0xf;
+            let mut mask = 0u32;
+            for (h, b) in node.bounds.iter().enumerate() {
+                mask |= (!outside(b) & 0xf) << (4 * h);
+            }
             while mask != 0 {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
@@ -278,11 +297,11 @@ impl Bvh4 {
 /// ray). The build keeps trees shallow enough that it never overflows.
 type Stack = arrayvec::ArrayVec<u32, STACK>;
 
-fn empty_node() -> Node4 {
+fn empty_node() -> WideNode {
     let (inf, neg) = (Vec4::splat(f32::INFINITY), Vec4::splat(f32::NEG_INFINITY));
-    Node4 {
-        bounds: [inf, inf, inf, neg, neg, neg],
-        child: [EMPTY; 4],
+    WideNode {
+        bounds: [[inf, inf, inf, neg, neg, neg]; HALVES],
+        child: [EMPTY; WIDTH],
     }
 }
 

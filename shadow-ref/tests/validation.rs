@@ -525,8 +525,8 @@ fn beam_culling_changes_nothing_but_time() {
 }
 
 #[test]
-fn four_wide_tree_equals_the_cwbvh() {
-    // The single-ray query on the project's four-wide tree and on `obvhs`'s CWBVH give the same
+fn wide_tree_equals_the_cwbvh() {
+    // The single-ray query on the project's wide tree and on `obvhs`'s CWBVH give the same
     // answer on every segment the reference casts on every built-in scene, and on axis-aligned
     // segments (zero direction components, infinite slab inverses) through each scene's box.
     for name in BUILTIN_SCENES {

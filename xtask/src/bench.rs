@@ -386,7 +386,7 @@ pub fn run(a: BenchArgs) -> Result<(), String> {
     );
     let query = query_throughput(&bunny, &a, seed)?;
     println!(
-        "bunny, {} identical segments, one thread: single-ray query {:.2} M rays/s (four-wide tree; {:.2} M rays/s on the CWBVH); reference trace with beam culling {:.2} M rays/s ({:.1}% occluded)",
+        "bunny, {} identical segments, one thread: single-ray query {:.2} M rays/s (wide tree; {:.2} M rays/s on the CWBVH); reference trace with beam culling {:.2} M rays/s ({:.1}% occluded)",
         query.rays,
         query.rays_per_second / 1e6,
         query.cwbvh_rays_per_second / 1e6,
@@ -536,7 +536,7 @@ pub fn run(a: BenchArgs) -> Result<(), String> {
 #[derive(Debug, Clone, Serialize)]
 struct QueryThroughput {
     rays: usize,
-    /// The single-ray BVH query alone (four-wide tree).
+    /// The single-ray BVH query alone (wide tree).
     rays_per_second: f64,
     /// The same query on `obvhs`'s CWBVH.
     cwbvh_rays_per_second: f64,
@@ -584,9 +584,7 @@ fn query_throughput(
                     .count();
                 cwbvh_best = cwbvh_best.min(t0.elapsed().as_secs_f64());
                 if n != occluded {
-                    return Err(format!(
-                        "CWBVH query: {n} occluded, four-wide tree: {occluded}"
-                    ));
+                    return Err(format!("CWBVH query: {n} occluded, wide tree: {occluded}"));
                 }
             }
             // The reference's whole trace phase (sampling, offsets, beam culling, queries) on the
