@@ -215,7 +215,8 @@ impl OcclusionBvh {
         self.occluded_cached(origin, dir, t_max, ignore, &mut last)
     }
 
-    /// The same query on the `obvhs` CWBVH with `ray_traverse_miss`, whatever the wide tree (for cross-checks and the benchmark).
+    /// The same query on the `obvhs` CWBVH with `ray_traverse_miss`, whatever the wide tree
+    /// (for cross-checks and the benchmark).
     pub fn occluded_cwbvh(&self, origin: Vec3, dir: Vec3, t_max: f32, ignore: u32) -> bool {
         let (o, d) = ray_parts(origin, dir);
         let sheared = ShearedRay::new(o, d);

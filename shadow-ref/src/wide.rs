@@ -60,12 +60,12 @@ pub struct WideBvh {
 }
 
 impl WideBvh {
-    /// Collapses `bvh2` into a wide tree whose leaves hold at most `max_leaf` primitives
-    /// (a BVH2 subtree with that many or fewer becomes one leaf). Each node takes the two
-    /// children of its BVH2 node and keeps opening the child with the largest surface area
-    /// until it has sixteen (the greedy collapse of Wald, Benthin and Boulos 2008). `None` when the tree
-    /// cannot be represented (a BVH2 leaf with more than [`MAX_LEAF`] primitives, 2^31
-    /// leaves or more, or deeper than the traversal stack allows).
+    /// Collapses `bvh2` into a wide tree whose leaves hold at most `max_leaf` primitives (a
+    /// BVH2 subtree with that many or fewer becomes one leaf). Each node takes the two children
+    /// of its BVH2 node and keeps opening the child with the largest surface area until it has
+    /// sixteen (the greedy collapse of Wald, Benthin and Boulos 2008). `None` when the tree
+    /// cannot be represented (a BVH2 leaf with more than [`MAX_LEAF`] primitives, 2^31 leaves
+    /// or more, or deeper than the traversal stack allows).
     pub fn collapse(bvh2: &Bvh2, max_leaf: usize) -> Option<Self> {
         let nodes2 = &bvh2.nodes;
         if nodes2.is_empty() {
@@ -173,7 +173,8 @@ impl WideBvh {
     }
 
     /// Visits the leaves whose boxes the segment `origin + t dir`, `0 <= t <= t_max`, may touch,
-    /// calling `test` with each leaf's number (as in [`WideBvh::leaves`]) until it returns true. Returns true when it did (the segment is blocked). `dir` must be finite and
+    /// calling `test` with each leaf's number (as in [`WideBvh::leaves`]) until it returns
+    /// true. Returns true when it did (the segment is blocked). `dir` must be finite and
     /// non-zero; negative zeros are harmless.
     #[inline]
     pub fn any_hit(
