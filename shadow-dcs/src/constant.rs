@@ -83,13 +83,26 @@ pub(crate) fn integration_constants(
         .map(|(p, _)| (p.as_dvec3() - cd).length())
         .fold((eyed - cd).length(), f64::max);
     let far_radius = reach * FAR_FACTOR;
-    let far = |v: DVec3| -> Option<Vec3> {
+    // Every crossing that counts lies on a segment from the eye to a view sample, so inside the
+    // box around the eye and the view samples: quads are clipped to it (with a margin that keeps
+    // counted crossings away from the cut).
+    let (lo, hi) = origins
+        .iter()
+        .zip(valid)
+        .filter(|(_, v)| **v)
+        .fold((eyed, eyed), |(lo, hi), (p, _)| {
+            (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
+        });
+    let margin = DVec3::splat((hi - lo).length() * 1e-3 + 1e-9 * reach.max(1.0));
+    let (lo, hi) = (lo - margin, hi + margin);
+    // The quads with a non-zero weight, seen from the eye, clipped to the box.
+    let far = |v: DVec3| -> Option<DVec3> {
         let d = v - cd;
         let l = d.length();
-        (l > 0.0).then(|| (cd + d * (far_radius / l)).as_vec3())
+        (l > 0.0).then(|| cd + d * (far_radius / l))
     };
-    // The quads with a non-zero weight, seen from the eye.
-    let quads: Vec<([Vec3; 4], i64, [DVec3; 3], bool)> = silhouettes
+    type Quad = (Vec<Vec3>, i64, [DVec3; 3], bool);
+    let quads: Vec<Quad> = silhouettes
         .iter()
         .filter_map(|&i| {
             let e = &edges[i as usize];
@@ -102,8 +115,12 @@ pub(crate) fn integration_constants(
                 return None;
             }
             let (af, bf) = (far(e.a)?, far(e.b)?);
+            let poly = clip_to_box(&[e.a, e.b, bf, af], lo, hi);
+            if poly.len() < 3 {
+                return None;
+            }
             Some((
-                [e.a.as_vec3(), e.b.as_vec3(), bf, af],
+                poly.iter().map(|v| v.as_vec3()).collect(),
                 k,
                 [cd, e.a, e.b],
                 eye_side > 0.0,
@@ -129,8 +146,9 @@ pub(crate) fn integration_constants(
                         acc[i] += k;
                     }
                 };
-                for_each_covered_pixel(&near_view, [q[0], q[1], q[2]], &mut visit);
-                for_each_covered_pixel(&near_view, [q[0], q[2], q[3]], &mut visit);
+                for j in 1..q.len() - 1 {
+                    for_each_covered_pixel(&near_view, [q[0], q[j], q[j + 1]], &mut visit);
+                }
                 acc
             },
         )
@@ -149,6 +167,50 @@ pub(crate) fn integration_constants(
         .map(|(s, v)| if *v { s + eye_constant } else { 0 })
         .collect();
     (out, quads.len() as u64)
+}
+
+/// The part of the convex planar polygon `poly` inside the box `lo..hi` (Sutherland-Hodgman).
+/// Each crossing is interpolated from the lexicographically smaller end point of its segment,
+/// so polygons sharing an edge get bit-identical clipped vertices there and the rasterizer's
+/// shared-edge rule still counts a pixel on it once.
+fn clip_to_box(poly: &[DVec3], lo: DVec3, hi: DVec3) -> Vec<DVec3> {
+    let mut cur: Vec<DVec3> = poly.to_vec();
+    let mut next = Vec::with_capacity(poly.len() + 6);
+    for axis in 0..3 {
+        for (bound, keep_below) in [(lo[axis], false), (hi[axis], true)] {
+            if cur.is_empty() {
+                return cur;
+            }
+            let inside = |v: DVec3| {
+                if keep_below {
+                    v[axis] <= bound
+                } else {
+                    v[axis] >= bound
+                }
+            };
+            next.clear();
+            let n = cur.len();
+            for i in 0..n {
+                let (a, b) = (cur[i], cur[(i + 1) % n]);
+                if inside(a) {
+                    next.push(a);
+                }
+                if inside(a) != inside(b) {
+                    let (p, q) = if a.to_array() < b.to_array() {
+                        (a, b)
+                    } else {
+                        (b, a)
+                    };
+                    let t = (bound - p[axis]) / (q[axis] - p[axis]);
+                    let mut x = p + (q - p) * t;
+                    x[axis] = bound;
+                    next.push(x);
+                }
+            }
+            std::mem::swap(&mut cur, &mut next);
+        }
+    }
+    cur
 }
 
 /// The camera view with its near plane moved to almost zero (perspective), so that quads

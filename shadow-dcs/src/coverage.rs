@@ -10,7 +10,9 @@
 //! is a linear function of `s`, set up once per (pixel, edge); each sample then costs four dot
 //! products.
 
-use glam::{DVec3, Vec3};
+#[cfg(test)]
+use glam::DVec3;
+use glam::Vec3;
 
 /// A pixel's light samples relative to its view sample `p`, structure of arrays, padded to
 /// whole 64-sample words so the per-edge loop has no tail and vectorises.
@@ -55,7 +57,10 @@ pub(crate) struct EdgeTest {
 
 impl EdgeTest {
     /// The test of edge `a b` seen from `p` with the light centre `c`; `None` when the line of
-    /// the edge meets the line `p c` (no sample can be covered robustly).
+    /// the edge meets the line `p c` (no sample can be covered robustly). The technique builds
+    /// the same test from light-centred data ([`crate::centred::CentredEdge`]); this direct form
+    /// is what tests check it against.
+    #[cfg(test)]
     pub fn new(p: DVec3, c: DVec3, a: DVec3, b: DVec3) -> Option<Self> {
         let ga = (a - p).cross(c - p);
         let gb = (b - p).cross(c - p);
@@ -67,14 +72,104 @@ impl EdgeTest {
         }
         // orient(a, b, c, s) = h1 . (s - a) = h1 . (s - p) + h1 . (p - a).
         let k1 = h1.dot(p - a);
-        let sign = if k0 > 0.0 { 1.0 } else { -1.0 };
-        Some(Self {
-            ga: ga.as_vec3(),
-            gb: gb.as_vec3(),
-            h1: (h1 * sign).as_vec3(),
-            k1: (k1 * sign) as f32,
-            h2: (h2 * sign).as_vec3(),
-        })
+        Some(Self::from_parts(
+            ga.as_vec3(),
+            gb.as_vec3(),
+            h2.as_vec3(),
+            h1.as_vec3(),
+            k1 as f32,
+            k0 > 0.0,
+        ))
+    }
+
+    /// The test from its parts: `ga`, `gb`, `h2 = (p - a) x (b - a)`, `h1 = (b - a) x (c - a)`,
+    /// `k1 = h1 . (p - a)`, and the sign of `k0 = orient(a, b, p, c)`.
+    #[inline]
+    pub(crate) fn from_parts(
+        ga: Vec3,
+        gb: Vec3,
+        h2: Vec3,
+        h1: Vec3,
+        k1: f32,
+        positive: bool,
+    ) -> Self {
+        let sign = if positive { 1.0 } else { -1.0 };
+        Self {
+            ga,
+            gb,
+            h1: h1 * sign,
+            k1: k1 * sign,
+            h2: h2 * sign,
+        }
+    }
+
+    /// `orient(p, c, s, a)` and `orient(p, c, s, b)` as linear functions of `s - p`: their
+    /// zero sets are the planes through `p`, `c` and an end point, which bound the angular
+    /// sector (used by [`crate::angular`]).
+    pub fn sector_normals(&self) -> (Vec3, Vec3) {
+        (self.ga, self.gb)
+    }
+
+    /// Whether the edge may cover any point of a convex planar light holding the centre `c`,
+    /// given the light's convex polygon relative to `p` (counter-clockwise or clockwise):
+    /// `false` proves that no light sample is covered, so the pair need not be kept.
+    ///
+    /// The covered region is `sector & w1 > 0 & w2 > 0`, with `w2 < 0` at `c`. If a light
+    /// point `q` is covered, the segment from `c` to `q` stays in the light, in the open
+    /// sector (a cone with apex `c`) and in `w1 > 0` (`w1(c) = 0`), and crosses `w2 = 0`: so
+    /// the chord `w2 = 0` of the light polygon meets the sector and `w1 > 0`. The chord is
+    /// found on the polygon's boundary and the three linear functions clipped along it, with
+    /// a relative slack of `1e-5` so that only clear misses are rejected (ties are kept).
+    pub fn may_cover(&self, polygon: &[Vec3]) -> bool {
+        let n = polygon.len();
+        // L1 norms bound the Euclidean ones from above: a looser, cheaper slack.
+        let reach = polygon
+            .iter()
+            .map(|v| v.abs().element_sum())
+            .fold(0.0f32, f32::max);
+        let tol = |g: Vec3| 1e-5 * g.abs().element_sum() * reach;
+        let t2 = tol(self.h2);
+        let mut ends = [Vec3::ZERO; 2];
+        let mut found = 0;
+        let mut any_beyond = false;
+        let mut prev = polygon[n - 1];
+        let mut fp = self.h2.dot(prev);
+        for &x in polygon {
+            let fx = self.h2.dot(x);
+            any_beyond |= fx > -t2;
+            if (fp > 0.0) != (fx > 0.0) {
+                if found == 2 {
+                    return true;
+                }
+                ends[found] = prev + (x - prev) * (fp / (fp - fx));
+                found += 1;
+            }
+            prev = x;
+            fp = fx;
+        }
+        if !any_beyond {
+            return false;
+        }
+        if found != 2 || !ends[0].is_finite() || !ends[1].is_finite() {
+            return true;
+        }
+        // Along the chord e0 + t (e1 - e0), t in [0, 1].
+        let [e0, e1] = ends;
+        let span = |g: Vec3, k: f32| (g.dot(e0) + k, g.dot(e1) + k);
+        let (w0, w1) = span(self.h1, self.k1);
+        let (a0, a1) = span(self.ga, 0.0);
+        let (b0, b1) = span(self.gb, 0.0);
+        if !(w0 + w1 + a0 + a1 + b0 + b1).is_finite() {
+            return true;
+        }
+        let (tw, ta, tb) = (tol(self.h1), tol(self.ga), tol(self.gb));
+        let whole = clip_unit((0.0, 1.0), w0 + tw, w1 + tw);
+        let cone = |sa: f32, sb: f32| {
+            let r = clip_unit(whole, sa * a0 + ta, sa * a1 + ta);
+            let r = clip_unit(r, sb * b0 + tb, sb * b1 + tb);
+            r.0 <= r.1
+        };
+        cone(1.0, -1.0) || cone(-1.0, 1.0)
     }
 
     /// True when the edge crosses the triangle `(p, c, p + d)`, `d` a sample relative to `p`.
@@ -92,6 +187,12 @@ impl EdgeTest {
     #[cfg(test)]
     pub fn covers(&self, p: Vec3, s: Vec3) -> bool {
         let d = s - p;
+        self.covers_relative(d.x, d.y, d.z)
+    }
+
+    /// True when the edge crosses the triangle `(p, c, p + d)`.
+    #[cfg(test)]
+    pub fn covers_offset(&self, d: Vec3) -> bool {
         self.covers_relative(d.x, d.y, d.z)
     }
 
@@ -133,6 +234,24 @@ impl EdgeTest {
             any |= *word;
         }
         any != 0
+    }
+}
+
+/// The part of the interval `r` (within `[0, 1]`) where the linear function with values `g0`
+/// at 0 and `g1` at 1 is non-negative.
+#[inline]
+fn clip_unit(r: (f32, f32), g0: f32, g1: f32) -> (f32, f32) {
+    match (g0 >= 0.0, g1 >= 0.0) {
+        (true, true) => r,
+        (false, false) => (1.0, 0.0),
+        (in0, _) => {
+            let t = g0 / (g0 - g1);
+            if in0 {
+                (r.0, r.1.min(t))
+            } else {
+                (r.0.max(t), r.1)
+            }
+        }
     }
 }
 

@@ -28,7 +28,9 @@
 
 #![deny(missing_docs)]
 
+mod angular;
 mod budgets;
+mod centred;
 pub mod constant;
 pub mod counters;
 pub mod coverage;

@@ -19,7 +19,56 @@ pub(crate) struct LightShape {
     pub radius: f32,
     /// Points whose convex hull holds the light.
     pub hull: Vec<Vec3>,
+    /// The light plane's frame and a convex polygon around the light, for planar lights.
+    pub plane: Option<LightPlane>,
     exact: Exact,
+}
+
+/// A planar light's frame and a convex polygon holding it, with the centre strictly inside:
+/// what the per-pixel light-plane tests need ([`crate::coverage::EdgeTest::may_cover`],
+/// [`crate::angular`]).
+#[derive(Debug, Clone)]
+pub(crate) struct LightPlane {
+    /// First in-plane axis (unit).
+    pub u: Vec3,
+    /// Second in-plane axis (unit, `normal x u`).
+    pub v: Vec3,
+    /// Convex polygon in the light plane holding the light, counter-clockwise in `(u, v)`.
+    pub polygon: Vec<Vec3>,
+}
+
+impl LightPlane {
+    /// The frame of a light with unit `normal` and first axis `u`, and the convex hull of the
+    /// in-plane points `points`; `None` when the centre is not strictly inside it.
+    fn new(center: Vec3, normal: Vec3, u: Vec3, points: &[Vec3]) -> Option<Self> {
+        let u = u.normalize();
+        let v = normal.cross(u).normalize();
+        let c = center.as_dvec3();
+        let (ud, vd) = (u.as_dvec3(), v.as_dvec3());
+        let flat: Vec<glam::DVec2> = points
+            .iter()
+            .map(|p| {
+                let d = p.as_dvec3() - c;
+                glam::DVec2::new(d.dot(ud), d.dot(vd))
+            })
+            .collect();
+        let hull = crate::wedges::convex_hull(flat);
+        let n = hull.len();
+        // Counter-clockwise, with the centre (the origin) strictly inside.
+        let inside = n >= 3
+            && (0..n).all(|i| {
+                let (a, b) = (hull[i], hull[(i + 1) % n]);
+                a.perp_dot(b) > 1e-9 * a.length() * b.length()
+            });
+        inside.then(|| Self {
+            u,
+            v,
+            polygon: hull
+                .iter()
+                .map(|q| (c + ud * q.x + vd * q.y).as_vec3())
+                .collect(),
+        })
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -44,6 +93,13 @@ impl LightShape {
     /// [`TechniqueError::Unsupported`] for point lights (no area, no penumbra).
     pub fn new(light: &dyn AreaLight, technique: &str) -> Result<Self, TechniqueError> {
         let center = light.center();
+        let frame = match light.geometry() {
+            LightGeometry::Rectangle { normal, half_u, .. } => Some((normal, half_u)),
+            LightGeometry::Disk { normal, .. } | LightGeometry::Polygon { normal, .. } => {
+                Some((normal, shadow_core::geometry::orthonormal_basis(normal).0))
+            }
+            _ => None,
+        };
         let (hull, exact) = match light.geometry() {
             LightGeometry::Rectangle {
                 center: c,
@@ -116,10 +172,12 @@ impl LightShape {
             .iter()
             .map(|p: &Vec3| (*p - center).length())
             .fold(0.0f32, f32::max);
+        let plane = frame.and_then(|(n, u)| LightPlane::new(center, n, u, &hull));
         Ok(Self {
             center,
             radius,
             hull,
+            plane,
             exact,
         })
     }

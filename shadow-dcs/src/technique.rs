@@ -33,13 +33,15 @@ use shadow_core::technique::{Capabilities, Processor, SceneRef};
 use shadow_core::view_samples::ViewSample;
 use shadow_core::visibility::{PerSampleVisibility, PixelClass};
 
+use crate::angular::AngularIndex;
+use crate::centred::CentredEdge;
 use crate::constant::{eye_constant, integration_constants};
 use crate::counters::{Packed, WIDTHS, width_for};
 use crate::coverage::{EdgeTest, RelativeSamples};
 use crate::discrete::{CoveredSamples, DiscreteTables};
 use crate::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
 use crate::light_shape::LightShape;
-use crate::wedges::{Region, band_pairs, wedge_regions};
+use crate::wedges::{Pair, Region, band_pairs, wedge_regions};
 
 /// What per-sample visibility an estimate returns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -64,6 +66,10 @@ struct Prepared {
     offset: RayOffset,
     extent: f64,
     tables: Option<DiscreteTables>,
+    /// The planar light's convex polygon around its centre, for [`EdgeTest::may_cover`].
+    polygon: Option<Vec<Vec3>>,
+    /// Every edge around the light centre (same indices as `edges`).
+    centred_edges: Vec<CentredEdge>,
 }
 
 /// Depth complexity sampling.
@@ -91,6 +97,8 @@ impl std::fmt::Debug for Dcs {
 /// Per-frame data shared by every pixel.
 struct Frame<'a> {
     origins: Vec<Vec3>,
+    /// `origins` relative to the light centre ([`crate::centred`]).
+    centred: Vec<Vec3>,
     horizon: Vec<Horizon>,
     active: Vec<bool>,
     constants: Vec<i64>,
@@ -98,6 +106,10 @@ struct Frame<'a> {
     bits: u32,
     view: &'a ViewSamples,
 }
+
+/// Candidates up to which an edge's samples are tested one by one rather than a whole word
+/// at a time.
+const FEW_CANDIDATES: u32 = 12;
 
 /// Rows per band: wedge pairs exist for one band at a time, which bounds their memory on scenes
 /// of very high depth complexity (`grass`).
@@ -118,7 +130,12 @@ struct Scratch {
     samples: Vec<LightSample>,
     positions: Vec<Vec3>,
     relative: RelativeSamples,
+    angular: AngularIndex,
+    polygon: Vec<Vec3>,
+    tests: Vec<(u32, i32, EdgeTest)>,
     above: Vec<u64>,
+    mask: Vec<u64>,
+    candidates: Vec<u64>,
     masks: Vec<u64>,
     weights: Vec<i64>,
     packed: Packed,
@@ -141,6 +158,8 @@ struct Counts {
     ties: u64,
     scanned: u64,
     pairs: u64,
+    off_light: u64,
+    sector_empty: u64,
 }
 
 impl Counts {
@@ -156,6 +175,8 @@ impl Counts {
         self.ties += o.ties;
         self.scanned += o.scanned;
         self.pairs += o.pairs;
+        self.off_light += o.off_light;
+        self.sector_empty += o.sector_empty;
     }
 }
 
@@ -281,8 +302,14 @@ impl Dcs {
         });
         stats.add("wedges", regions.len() as u64);
         stats.add("wedges-unbounded", unbounded);
+        let cd = p.shape.center.as_dvec3();
+        let centred = origins
+            .iter()
+            .map(|o| (o.as_dvec3() - cd).as_vec3())
+            .collect();
         Ok(Frame {
             origins,
+            centred,
             horizon,
             active,
             constants,
@@ -311,6 +338,7 @@ impl Dcs {
             view.raster_view(),
             rows,
             &f.origins,
+            &f.centred,
             &f.active,
             p.extent,
         );
@@ -356,7 +384,7 @@ impl Dcs {
         f: &Frame,
         i: usize,
         s: &ViewSample,
-        entries: &[(u32, i32)],
+        entries: &[Pair],
         scratch: &mut Scratch,
         counts: &mut Counts,
     ) -> PixelClass {
@@ -381,7 +409,28 @@ impl Dcs {
         let d0 = d0 as u64;
         let units = p.units as f32;
         let textured = p.light.is_textured();
-        if entries.is_empty() && horizon == Horizon::Above {
+        // Each pair's covered-sample test, kept when the edge may cover part of the light.
+        let o = origin.as_dvec3();
+        let c = p.shape.center.as_dvec3();
+        scratch.tests.clear();
+        if let Some(poly) = &p.polygon {
+            scratch.polygon.clear();
+            let x = f.centred[i];
+            scratch.polygon.extend(poly.iter().map(|v| *v - x));
+        }
+        let pc = o - c;
+        for pair in entries {
+            let Some(test) = p.centred_edges[pair.edge as usize].test(pc) else {
+                counts.ties += 1;
+                continue;
+            };
+            if p.polygon.is_some() && !test.may_cover(&scratch.polygon) {
+                counts.off_light += 1;
+                continue;
+            }
+            scratch.tests.push((pair.edge, pair.k, test));
+        }
+        if scratch.tests.is_empty() && horizon == Horizon::Above {
             // No wedge: every sample has the integration constant.
             counts.constant_only += 1;
             let v = 1.0 - (d0 as f32 / units).min(1.0);
@@ -424,33 +473,51 @@ impl Dcs {
         // Covered samples of every wedge edge.
         scratch.masks.clear();
         scratch.weights.clear();
-        let c = p.shape.center.as_dvec3();
-        let o = origin.as_dvec3();
         scratch.relative.set(origin, &scratch.positions);
-        let mut mask = vec![0u64; words];
-        for &(e, k) in entries {
-            let edge = &p.edges[e as usize];
-            let Some(test) = EdgeTest::new(o, c, edge.a, edge.b) else {
-                counts.ties += 1;
-                continue;
-            };
+        let indexed = match (&p.shape.plane, self.covered) {
+            (Some(plane), CoveredSamples::Exact) => {
+                scratch
+                    .angular
+                    .build(plane, p.shape.center, &scratch.positions);
+                true
+            }
+            _ => false,
+        };
+        for v in [&mut scratch.mask, &mut scratch.candidates] {
+            v.clear();
+            v.resize(words, 0);
+        }
+        for (edge, k, test) in &scratch.tests {
             counts.edge_tests += 1;
+            let (mask, cand) = (&mut scratch.mask, &mut scratch.candidates);
             let any = match (&self.covered, &p.tables) {
                 (CoveredSamples::Discrete | CoveredSamples::Refined, Some(t)) => t.mask(
                     s.pixel,
-                    &test,
+                    test,
                     o,
-                    edge,
+                    &p.edges[*edge as usize],
                     &scratch.relative,
                     &scratch.above,
-                    &mut mask,
+                    mask,
                 ),
-                _ => test.mask(&scratch.relative, &scratch.above, &mut mask),
+                _ if indexed => {
+                    if !scratch.angular.candidates(test, &scratch.above, cand) {
+                        counts.sector_empty += 1;
+                        false
+                    } else if cand.iter().map(|w| w.count_ones()).sum::<u32>() <= FEW_CANDIDATES {
+                        mask.fill(0);
+                        test.add_covered(&scratch.relative, cand, mask);
+                        mask.iter().any(|w| *w != 0)
+                    } else {
+                        test.mask(&scratch.relative, cand, mask)
+                    }
+                }
+                _ => test.mask(&scratch.relative, &scratch.above, mask),
             };
             if any {
                 counts.covered_updates += 1;
-                scratch.masks.extend_from_slice(&mask);
-                scratch.weights.push(k as i64);
+                scratch.masks.extend_from_slice(mask);
+                scratch.weights.push(*k as i64);
             }
         }
         // Packed counters, outer wedges (k > 0) before inner ones (section 4.4); wider lanes on
@@ -645,7 +712,18 @@ impl ShadowTechnique for Dcs {
             CoveredSamples::Exact => None,
         };
         let extent = scene.bounds().union(light.bounds()).diagonal();
+        let polygon = shape.plane.as_ref().map(|pl| {
+            let c = shape.center.as_dvec3();
+            pl.polygon
+                .iter()
+                .map(|v| (v.as_dvec3() - c).as_vec3())
+                .collect()
+        });
+        let cd = shape.center.as_dvec3();
+        let centred_edges = edges.iter().map(|e| CentredEdge::new(e, cd)).collect();
         self.prepared = Some(Prepared {
+            polygon,
+            centred_edges,
             scene,
             light,
             shape,
@@ -785,6 +863,8 @@ impl ShadowTechnique for Dcs {
         stats.add("edge-ties", counts.ties);
         stats.add("wedge-pixels-scanned", counts.scanned);
         stats.add("wedge-pairs", counts.pairs);
+        stats.add("wedge-pairs-off-light", counts.off_light);
+        stats.add("wedge-pairs-empty-sector", counts.sector_empty);
         vis.validate()?;
         Ok(Estimate {
             visibility: vis,

@@ -16,8 +16,18 @@ use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 use shadow_core::raster::RasterView;
 
+use crate::centred::{CentredPlane, FastWeight};
 use crate::edges::SceneEdge;
 use crate::light_shape::LightShape;
+
+/// One (pixel, silhouette edge) pair: the edge and its weight `k_e(p)`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Pair {
+    /// Index into the scene edge list.
+    pub edge: u32,
+    /// `k_e(p)`: positive for the outer part of the wedge, negative for the inner part.
+    pub k: i32,
+}
 
 /// The (pixel, edge, weight) pairs of a band of rows, grouped by pixel in edge order (CSR).
 #[derive(Debug, Default)]
@@ -26,15 +36,15 @@ pub(crate) struct WedgePairs {
     pub first: usize,
     /// `start[i]..start[i + 1]` indexes the entries of band pixel `i`.
     pub start: Vec<u32>,
-    /// Silhouette edge index (into the scene edge list) and its weight at the pixel.
-    pub entries: Vec<(u32, i32)>,
+    /// The pairs, by pixel.
+    pub entries: Vec<Pair>,
     /// Pixels scanned inside wedge hulls (before the exact test).
     pub scanned: u64,
 }
 
 impl WedgePairs {
     /// The entries of pixel `i` (image index, inside the band).
-    pub fn of(&self, i: usize) -> &[(u32, i32)] {
+    pub fn of(&self, i: usize) -> &[Pair] {
         let j = i - self.first;
         &self.entries[self.start[j] as usize..self.start[j + 1] as usize]
     }
@@ -47,11 +57,15 @@ pub(crate) struct Region {
     /// Convex polygon in pixel units; `None` scans the whole image.
     poly: Option<Vec<DVec2>>,
     rows: (u32, u32),
-    /// Half-spaces holding the wedge ([`wedge_planes`]).
-    planes: Vec<Plane>,
+    /// Half-spaces holding the wedge ([`wedge_planes`]) around the light centre, in single
+    /// precision (their slack covers its rounding).
+    centred_planes: Vec<CentredPlane>,
     /// The planes of the edge's two faces, oriented by the edge, when the edge's weight can
-    /// only be non-zero where it is a silhouette of the view sample ([`fold_planes`]).
-    fold: Option<(Plane, Plane)>,
+    /// only be non-zero where it is a silhouette of the view sample ([`fold_planes`]), around
+    /// the light centre.
+    centred_fold: Option<(CentredPlane, CentredPlane)>,
+    /// The weight from plane signs, for edges with one or two faces.
+    weight: Option<FastWeight>,
 }
 
 /// A half-space `n . x + d >= 0` (`n` unit).
@@ -66,6 +80,11 @@ impl Plane {
     fn eval(&self, x: DVec3) -> f64 {
         self.n.dot(x) + self.d
     }
+    /// The plane around the light centre `c`, in single precision.
+    fn centred(&self, c: DVec3) -> CentredPlane {
+        CentredPlane::new(self.n, self.d, c)
+    }
+
     /// The largest value over a box (its corner furthest along `n`).
     #[inline]
     fn max_over(&self, lo: DVec3, hi: DVec3) -> f64 {
@@ -175,15 +194,10 @@ const FOLD_SLACK: f64 = 1e-6;
 
 /// Whether a box may hold a view sample of which the edge is a silhouette.
 #[inline]
-fn fold_possible_in(f: &(Plane, Plane), lo: DVec3, hi: DVec3, slack: f64) -> bool {
+fn fold_possible_in(f: &(CentredPlane, CentredPlane), lo: Vec3, hi: Vec3, slack: f32) -> bool {
     let (max1, max2) = (f.0.max_over(lo, hi), f.1.max_over(lo, hi));
-    let (min1, min2) = (-neg(f.0).max_over(lo, hi), -neg(f.1).max_over(lo, hi));
+    let (min1, min2) = (f.0.min_over(lo, hi), f.1.min_over(lo, hi));
     (max1 > -slack && max2 > -slack) || (min1 < slack && min2 < slack)
-}
-
-#[inline]
-fn neg(p: Plane) -> Plane {
-    Plane { n: -p.n, d: -p.d }
 }
 
 /// Per-tile bounds of the active view samples: tiles of [`TILE_W`] columns by one band of rows.
@@ -202,14 +216,14 @@ fn union_boxes(boxes: &[TileBox]) -> TileBox {
     })
 }
 
-/// `None` for a tile with no active view sample.
-pub(crate) type TileBox = Option<(DVec3, DVec3)>;
+/// `None` for a tile with no active view sample; light-centred coordinates.
+pub(crate) type TileBox = Option<(Vec3, Vec3)>;
 
-/// The bounds of every tile of a band.
+/// The bounds of every tile of a band, from the light-centred view samples.
 fn band_tiles(
     view: &RasterView,
     rows: (u32, u32),
-    origins: &[Vec3],
+    centred: &[Vec3],
     active: &[bool],
 ) -> Vec<TileBox> {
     let w = view.width as usize;
@@ -221,7 +235,7 @@ fn band_tiles(
             if !active[i] {
                 continue;
             }
-            let p = origins[i].as_dvec3();
+            let p = centred[i];
             let t = &mut out[x / TILE_W as usize];
             *t = Some(match *t {
                 Some((lo, hi)) => (lo.min(p), hi.max(p)),
@@ -263,33 +277,32 @@ pub(crate) fn wedge_regions(
             if planes.iter().any(|p| p.max_over(lo, hi) < 0.0) {
                 return None;
             }
-            match screen_region(e, &hull, c, light.radius as f64, lo, hi, view) {
-                None => Some(Region {
-                    edge: ei,
-                    poly: None,
-                    rows: (0, view.height - 1),
-                    planes,
-                    fold,
-                }),
+            let (poly, rows) = match screen_region(e, &hull, c, light.radius as f64, lo, hi, view) {
+                None => (None, (0, view.height - 1)),
                 Some(poly) => {
                     let rows = polygon_rows(&poly, view.height)?;
-                    Some(Region {
-                        edge: ei,
-                        poly: Some(poly),
-                        rows,
-                        planes,
-                        fold,
-                    })
+                    (Some(poly), rows)
                 }
-            }
+            };
+            Some(Region {
+                edge: ei,
+                poly,
+                rows,
+                centred_planes: planes.iter().map(|p| p.centred(c)).collect(),
+                centred_fold: fold.map(|(a, b)| (a.centred(c), b.centred(c))),
+                weight: FastWeight::new(e, c),
+            })
         })
         .collect();
     let unbounded = regions.iter().filter(|r| r.poly.is_none()).count() as u64;
     (regions, unbounded)
 }
 
-/// The pairs of rows `rows` (a band): every region overlapping the band is scanned there, and
+/// The pairs of rows `rows` (a band): every region overlapping the band is scanned there (its
+/// screen polygon's column range over the band's rows, tile by tile, skipping tiles whose view
+/// samples' box lies outside the wedge's planes or where the edge cannot be a silhouette), and
 /// each active pixel with a non-zero weight `k_e(p)` is kept.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn band_pairs(
     edges: &[SceneEdge],
     regions: &[Region],
@@ -297,18 +310,19 @@ pub(crate) fn band_pairs(
     view: &RasterView,
     rows: (u32, u32),
     origins: &[Vec3],
+    centred: &[Vec3],
     active: &[bool],
     scale: f64,
 ) -> WedgePairs {
     let w = view.width as usize;
     let first = rows.0 as usize * w;
     let n = (rows.1 - rows.0 + 1) as usize * w;
-    let mut found: Vec<(u32, u32, i32)> = Vec::new();
+    let mut found: Vec<(u32, Pair)> = Vec::new();
     let mut scanned = 0u64;
-    let tiles = band_tiles(view, rows, origins, active);
+    let tiles = band_tiles(view, rows, centred, active);
     let groups: Vec<TileBox> = tiles.chunks(GROUP).map(union_boxes).collect();
     let band_box = union_boxes(&groups);
-    let slack = FOLD_SLACK * scale;
+    let slack = (FOLD_SLACK * scale) as f32;
     let Some((band_lo, band_hi)) = band_box else {
         return WedgePairs {
             first,
@@ -317,13 +331,12 @@ pub(crate) fn band_pairs(
             scanned: 0,
         };
     };
-    let rejects = |r: &Region, lo: DVec3, hi: DVec3| -> bool {
-        r.planes.iter().any(|p| p.max_over(lo, hi) < 0.0)
-            || r.fold
+    let rejects = |r: &Region, lo: Vec3, hi: Vec3| -> bool {
+        r.centred_planes.iter().any(|p| p.max_over(lo, hi) < 0.0)
+            || r.centred_fold
                 .as_ref()
                 .is_some_and(|f| !fold_possible_in(f, lo, hi, slack))
     };
-    let mut spans: Vec<(u32, u32, u32)> = Vec::with_capacity(4);
     for r in regions {
         if r.rows.1 < rows.0 || r.rows.0 > rows.1 {
             continue;
@@ -331,81 +344,75 @@ pub(crate) fn band_pairs(
         if rejects(r, band_lo, band_hi) {
             continue;
         }
-        let e = &edges[r.edge as usize];
-        spans.clear();
-        for y in rows.0.max(r.rows.0)..=rows.1.min(r.rows.1) {
-            let span = match &r.poly {
-                Some(poly) => row_span(poly, y, view.width),
-                None => Some((0, view.width - 1)),
-            };
-            if let Some((x0, x1)) = span {
-                spans.push((y, x0, x1));
-            }
-        }
-        let (Some(xmin), Some(xmax)) = (
-            spans.iter().map(|s| s.1).min(),
-            spans.iter().map(|s| s.2).max(),
-        ) else {
+        let (y0, y1) = (rows.0.max(r.rows.0), rows.1.min(r.rows.1));
+        let span = match &r.poly {
+            Some(poly) => band_span(poly, y0, y1, view.width),
+            None => Some((0, view.width - 1)),
+        };
+        let Some((xmin, xmax)) = span else {
             continue;
         };
-        let mut group_ok = (u32::MAX, false);
-        for t in xmin / TILE_W..=xmax / TILE_W {
-            let g = t / GROUP as u32;
-            if group_ok.0 != g {
-                group_ok = (
-                    g,
-                    groups[g as usize].is_some_and(|(lo, hi)| !rejects(r, lo, hi)),
-                );
-            }
-            if !group_ok.1 {
+        let e = &edges[r.edge as usize];
+        let mut t = xmin / TILE_W;
+        while t <= xmax / TILE_W {
+            let g = t as usize / GROUP;
+            if groups[g].is_none_or(|(lo, hi)| rejects(r, lo, hi)) {
+                t = (g as u32 + 1) * GROUP as u32;
                 continue;
             }
-            let Some((lo, hi)) = tiles[t as usize] else {
+            let tile = tiles[t as usize];
+            t += 1;
+            let Some((lo, hi)) = tile else {
                 continue;
             };
             if rejects(r, lo, hi) {
                 continue;
             }
-            let (c0, c1) = (t * TILE_W, (t * TILE_W + TILE_W - 1).min(view.width - 1));
-            for &(y, x0, x1) in &spans {
-                for x in x0.max(c0)..=x1.min(c1) {
+            let tc = t - 1;
+            let (c0, c1) = (
+                (tc * TILE_W).max(xmin),
+                (tc * TILE_W + TILE_W - 1).min(xmax),
+            );
+            for y in y0..=y1 {
+                for x in c0..=c1 {
                     let i = y as usize * w + x as usize;
                     scanned += 1;
                     if !active[i] {
                         continue;
                     }
-                    let o = origins[i].as_dvec3();
-                    if r.planes.iter().any(|p| p.eval(o) < 0.0) {
+                    let x = centred[i];
+                    if r.centred_planes.iter().any(|p| p.eval(x) < 0.0) {
                         continue;
                     }
-                    if let Some((f1, f2)) = &r.fold {
-                        let (g1, g2) = (f1.eval(o), f2.eval(o));
-                        if !((g1 > -slack && g2 > -slack) || (g1 < slack && g2 < slack)) {
-                            continue;
-                        }
-                    }
-                    if let Some(k) = e.sweep_weight(o, c, false)
-                        && k != 0
-                    {
+                    let fast = r
+                        .weight
+                        .as_ref()
+                        .and_then(|f| f.weight(x, x.abs().element_sum()));
+                    let Some(k) = fast.or_else(|| e.sweep_weight(origins[i].as_dvec3(), c, false))
+                    else {
+                        continue;
+                    };
+                    if k != 0 {
                         let k = k.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
-                        found.push(((i - first) as u32, r.edge, k));
+                        found.push(((i - first) as u32, Pair { edge: r.edge, k }));
                     }
                 }
             }
         }
     }
     let mut start = vec![0u32; n + 1];
-    for (j, _, _) in &found {
+    for (j, _) in &found {
         start[*j as usize + 1] += 1;
     }
     for j in 0..n {
         start[j + 1] += start[j];
     }
+    // Counting sort by pixel, stable: each pixel's pairs stay in edge order.
     let mut fill = start.clone();
-    let mut entries = vec![(0u32, 0i32); found.len()];
-    for (j, e, k) in found {
+    let mut entries = vec![Pair { edge: 0, k: 0 }; found.len()];
+    for (j, pair) in found {
         let slot = &mut fill[j as usize];
-        entries[*slot as usize] = (e, k);
+        entries[*slot as usize] = pair;
         *slot += 1;
     }
     WedgePairs {
@@ -414,6 +421,49 @@ pub(crate) fn band_pairs(
         entries,
         scanned,
     }
+}
+
+/// The columns whose pixel centres a convex polygon may cover on rows `y0..=y1` (the union of
+/// the rows' spans, up to the polygon's slope across the band), `None` when none.
+fn band_span(poly: &[DVec2], y0: u32, y1: u32, width: u32) -> Option<(u32, u32)> {
+    let n = poly.len();
+    if n == 0 {
+        return None;
+    }
+    let (ylo, yhi) = (y0 as f64 + 0.5 - PAD, y1 as f64 + 0.5 + PAD);
+    let (mut xl, mut xr) = (f64::INFINITY, f64::NEG_INFINITY);
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[(i + 1) % n]);
+        let (top, bottom) = (a.y.min(b.y), a.y.max(b.y));
+        if bottom < ylo || top > yhi {
+            continue;
+        }
+        // The part of the edge inside the slab.
+        let dy = b.y - a.y;
+        let (t0, t1) = if dy.abs() < 1e-12 {
+            (0.0, 1.0)
+        } else {
+            let (s0, s1) = ((ylo - a.y) / dy, (yhi - a.y) / dy);
+            (s0.min(s1).max(0.0), s0.max(s1).min(1.0))
+        };
+        for t in [t0, t1] {
+            let x = a.x + (b.x - a.x) * t;
+            xl = xl.min(x);
+            xr = xr.max(x);
+        }
+    }
+    if n < 3 && !(xl <= xr) {
+        for p in poly {
+            xl = xl.min(p.x);
+            xr = xr.max(p.x);
+        }
+    }
+    if !(xl <= xr) {
+        return None;
+    }
+    let x0 = (xl - PAD - 0.5).ceil().max(0.0);
+    let x1 = (xr + PAD - 0.5).floor().min(width as f64 - 1.0);
+    (x0 <= x1).then_some((x0 as u32, x1 as u32))
 }
 
 /// Rows whose centres a convex polygon may cover, `None` when none.
@@ -465,6 +515,13 @@ fn screen_region(
             pts.push(v * (1.0 + big_t) - *l * big_t);
         }
     }
+    // Only the part inside the view samples' box can hold one: clip the hull to it.
+    let pad = (hi - lo).length() * 1e-6 + 1e-12;
+    let dir = (e.a + e.b) * 0.5 - c;
+    let pts = clip_hull_to_box(pts, dir, lo - DVec3::splat(pad), hi + DVec3::splat(pad));
+    if pts.is_empty() {
+        return Some(Vec::new());
+    }
     let to_view = view.view_from_world;
     let m = glam::Mat4::from(to_view).as_dmat4();
     let vp: Vec<DVec3> = pts.iter().map(|p| m.transform_point3(*p)).collect();
@@ -510,9 +567,41 @@ fn screen_region(
     Some(convex_hull(screen))
 }
 
+/// Points whose convex hull is the convex hull of `pts` clipped by the box face that the
+/// direction `dir` leaves through (the one along its largest component): the points inside the
+/// face and the crossings of every segment from an inside point to an outside one (every vertex
+/// of a clipped polytope is an inside vertex or lies on an edge that crosses the face). One face
+/// keeps the point count small; the other faces would cut less of a wedge.
+fn clip_hull_to_box(pts: Vec<DVec3>, dir: DVec3, lo: DVec3, hi: DVec3) -> Vec<DVec3> {
+    let axis = dir.abs().max_position();
+    let below = dir[axis] > 0.0;
+    let bound = if below { hi[axis] } else { lo[axis] };
+    let inside = |p: &DVec3| {
+        if below {
+            p[axis] <= bound
+        } else {
+            p[axis] >= bound
+        }
+    };
+    let (ins, outs): (Vec<DVec3>, Vec<DVec3>) = pts.iter().partition(|p| inside(p));
+    if outs.is_empty() {
+        return ins;
+    }
+    let mut next = ins.clone();
+    for a in &ins {
+        for b in &outs {
+            let t = (bound - a[axis]) / (b[axis] - a[axis]);
+            let mut x = *a + (*b - *a) * t;
+            x[axis] = bound;
+            next.push(x);
+        }
+    }
+    next
+}
+
 /// Andrew's monotone chain; counter-clockwise in a y-up frame (orientation is irrelevant to the
 /// scan).
-fn convex_hull(mut p: Vec<DVec2>) -> Vec<DVec2> {
+pub(crate) fn convex_hull(mut p: Vec<DVec2>) -> Vec<DVec2> {
     p.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
     p.dedup();
     if p.len() < 3 {
@@ -542,41 +631,3 @@ fn convex_hull(mut p: Vec<DVec2>) -> Vec<DVec2> {
 
 /// Slack in pixels around wedge polygons.
 const PAD: f64 = 0.01;
-
-/// The pixels of row `y` whose centres lie inside (or within [`PAD`] of) the convex polygon
-/// `poly`, as an inclusive column range.
-fn row_span(poly: &[DVec2], y: u32, width: u32) -> Option<(u32, u32)> {
-    let n = poly.len();
-    if n == 0 {
-        return None;
-    }
-    let yc = y as f64 + 0.5;
-    let (mut xl, mut xr) = (f64::INFINITY, f64::NEG_INFINITY);
-    if n < 3 {
-        for p in poly {
-            xl = xl.min(p.x);
-            xr = xr.max(p.x);
-        }
-    }
-    for i in 0..n {
-        let (a, b) = (poly[i], poly[(i + 1) % n]);
-        if yc < a.y.min(b.y) - PAD || yc > a.y.max(b.y) + PAD {
-            continue;
-        }
-        if (b.y - a.y).abs() < 1e-12 {
-            xl = xl.min(a.x.min(b.x));
-            xr = xr.max(a.x.max(b.x));
-        } else {
-            let t = ((yc - a.y) / (b.y - a.y)).clamp(0.0, 1.0);
-            let x = a.x + (b.x - a.x) * t;
-            xl = xl.min(x);
-            xr = xr.max(x);
-        }
-    }
-    if !(xl <= xr) {
-        return None;
-    }
-    let x0 = (xl - PAD - 0.5).ceil().max(0.0);
-    let x1 = (xr + PAD - 0.5).floor().min(width as f64 - 1.0);
-    (x0 <= x1).then_some((x0 as u32, x1 as u32))
-}

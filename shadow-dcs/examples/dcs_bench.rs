@@ -1,0 +1,59 @@
+//! DCS against the reference with the same samples, in one process:
+//!
+//!     cargo run --release -p shadow-dcs --example dcs_bench -- [SCENE] [SIZE] [SAMPLES] [RUNS]
+//!
+//! Prints the best-of-`RUNS` wall time of each (all threads), DCS's phase times and counters of
+//! its last run, the ratio and the per-sample agreement; fails when agreement is below 99.9%.
+
+use std::time::Instant;
+
+use shadow_core::prelude::*;
+use shadow_dcs::Dcs;
+use shadow_ref::Reference;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let scene = args.first().map_or("bunny", String::as_str);
+    let size: u32 = args.get(1).map_or(Ok(512), |s| s.parse())?;
+    let n: u32 = args.get(2).map_or(Ok(64), |s| s.parse())?;
+    let runs: u32 = args.get(3).map_or(Ok(5), |s| s.parse())?;
+    let setup = shadow_core::scenes::builtin(scene)?;
+    let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), size, size)?;
+    let light = setup.lights[0].clone();
+    let mut dcs = Dcs::new(n, SamplingStrategy::Stratified, 1)?;
+    dcs.prepare(setup.scene.clone(), light.clone())?;
+    let sampler = dcs.light_sampler().ok_or("no sampler")?.clone();
+    let mut r = Reference::same_samples(sampler);
+    r.prepare(setup.scene.clone(), light)?;
+    let best = |t: &mut dyn ShadowTechnique| -> Result<(f64, Estimate), TechniqueError> {
+        let mut secs = f64::INFINITY;
+        let mut last = None;
+        for _ in 0..runs {
+            let t0 = Instant::now();
+            let e = t.estimate(&view)?;
+            secs = secs.min(t0.elapsed().as_secs_f64());
+            last = Some(e);
+        }
+        Ok((secs, last.expect("at least one run")))
+    };
+    let (td, ed) = best(&mut dcs)?;
+    let (tr, er) = best(&mut r)?;
+    let m = shadow_core::metrics::compare(&ed.visibility, &er.visibility)?;
+    for p in &ed.stats.phases {
+        print!("{} {:.4}s  ", p.name, p.seconds);
+    }
+    println!();
+    for (k, v) in &ed.stats.counters {
+        print!("{k}={v} ");
+    }
+    println!();
+    let agree = m.sample_agreement.unwrap_or(0.0);
+    println!(
+        "{scene} {size}x{size}, {n} samples: DCS {td:.4}s, reference {tr:.4}s, DCS is {:.2}x the reference; agreement {agree:.7}",
+        tr / td
+    );
+    if agree < 0.999 {
+        return Err("per-sample agreement below 99.9%".into());
+    }
+    Ok(())
+}

@@ -1,0 +1,157 @@
+//! A per-pixel angular index of the light samples (planar lights), after the sector table of
+//! DCS section 7.3 (Fig. 8) but built for each pixel's own samples, so that it serves
+//! stratified and decorrelated sampling, and used only to find candidates: the exact test of
+//! [`crate::coverage`] still decides every candidate.
+//!
+//! The samples an edge covers lie in its angular sector around the light centre `c`, between
+//! the lines where the planes `(p, c, a)` and `(p, c, b)` cut the light plane (Algorithm 1,
+//! lines 4-5). Each sample is put in one of [`BUCKETS`] buckets by the direction of the line
+//! from `c` through it (an angle modulo `pi`, so the double cone where the two orientation
+//! tests differ is one circular interval); prefix masks over the buckets then give, with two
+//! loads and two bit operations, every sample whose direction lies in the sector's interval
+//! widened by [`MARGIN`]. Most wedge pairs of a finely tessellated mesh have thin sectors
+//! holding no sample at all and are dropped without a per-sample test.
+
+use glam::Vec3;
+
+use crate::coverage::EdgeTest;
+use crate::light_shape::LightPlane;
+
+/// Angular buckets over a half turn.
+pub(crate) const BUCKETS: usize = 128;
+
+/// Widening of a sector's interval, in pseudo-angle units (a half turn is 2): far above the
+/// rounding of the directions, so that no sample the exact test covers is left out.
+const MARGIN: f32 = 1e-3;
+
+/// The angular index of one pixel's samples.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct AngularIndex {
+    words: usize,
+    u: Vec3,
+    v: Vec3,
+    /// `prefix[j * words + w]`: the samples of word `w` whose direction lies in a bucket below
+    /// `j` (`BUCKETS + 1` entries per word).
+    prefix: Vec<u64>,
+}
+
+/// A direction's angle modulo a half turn, as a monotone pseudo-angle in `[0, 2)`: the line
+/// through the origin along `(x, y)`; 0 for the zero vector.
+#[inline]
+fn line_angle(x: f32, y: f32) -> f32 {
+    let (x, y) = if y < 0.0 || (y == 0.0 && x < 0.0) {
+        (-x, -y)
+    } else {
+        (x, y)
+    };
+    let r = x.abs() + y;
+    if !(r > 0.0) {
+        return 0.0;
+    }
+    // 1 - x / r runs from 0 (along +x) to 2 (along -x, excluded).
+    (1.0 - x / r).clamp(0.0, 2.0)
+}
+
+/// The bucket of a pseudo-angle in `[0, 2)`.
+#[inline]
+fn bucket(a: f32) -> usize {
+    ((a * (BUCKETS as f32 * 0.5)) as usize).min(BUCKETS - 1)
+}
+
+/// The direction `d` flipped, if needed, onto the half-plane [`line_angle`] measures from.
+#[inline]
+fn canonical(x: f32, y: f32) -> (f32, f32) {
+    if y < 0.0 || (y == 0.0 && x < 0.0) {
+        (-x, -y)
+    } else {
+        (x, y)
+    }
+}
+
+impl AngularIndex {
+    /// Indexes the sample `positions` of a pixel on the light `plane` with centre `c`.
+    pub fn build(&mut self, plane: &LightPlane, c: Vec3, positions: &[Vec3]) {
+        let words = positions.len().div_ceil(64);
+        self.words = words;
+        self.u = plane.u;
+        self.v = plane.v;
+        self.prefix.clear();
+        self.prefix.resize((BUCKETS + 1) * words, 0);
+        // Bucket contents first (in entry j + 1), then the running union.
+        for (k, s) in positions.iter().enumerate() {
+            let d = *s - c;
+            let b = bucket(line_angle(d.dot(plane.u), d.dot(plane.v)));
+            self.prefix[(b + 1) * words + k / 64] |= 1 << (k % 64);
+        }
+        for j in 1..=BUCKETS {
+            for w in 0..words {
+                self.prefix[j * words + w] |= self.prefix[(j - 1) * words + w];
+            }
+        }
+    }
+
+    /// Writes to `out` the samples of `allowed` that may lie in the sector of `test` (every
+    /// sample the exact test covers is among them); returns whether any is.
+    pub fn candidates(&self, test: &EdgeTest, allowed: &[u64], out: &mut [u64]) -> bool {
+        let (ga, gb) = test.sector_normals();
+        let (ax, ay) = (ga.dot(self.u), ga.dot(self.v));
+        let (bx, by) = (gb.dot(self.u), gb.dot(self.v));
+        let all = |out: &mut [u64]| {
+            out.copy_from_slice(allowed);
+            allowed.iter().any(|w| *w != 0)
+        };
+        // A sector plane (nearly) parallel to the light plane: leave it to the exact test.
+        let (la, lb) = ((ax * ax + ay * ay).sqrt(), (bx * bx + by * by).sqrt());
+        if !(la > 1e-4 * ga.length() && lb > 1e-4 * gb.length()) {
+            return all(out);
+        }
+        // Directions of the two boundary lines (perpendicular to the in-plane normals).
+        let (dax, day) = canonical(-ay, ax);
+        let (dbx, dby) = canonical(-by, bx);
+        let (ta, tb) = (line_angle(dax, day), line_angle(dbx, dby));
+        let (t1, t2) = (ta.min(tb), ta.max(tb));
+        // Between the two directions (the arc [t1, t2]): do the two tests differ there?
+        let (mx, my) = (dax / la + dbx / lb, day / la + dby / lb);
+        let (sa, sb) = (ax * mx + ay * my, bx * mx + by * my);
+        let mlen = (mx * mx + my * my).sqrt();
+        if !(sa.abs() > 1e-3 * la * mlen && sb.abs() > 1e-3 * lb * mlen) {
+            return all(out);
+        }
+        // The sector's interval, forward from `lo` to `hi` (circularly), widened.
+        let (lo, hi, len) = if (sa < 0.0) != (sb < 0.0) {
+            (t1 - MARGIN, t2 + MARGIN, t2 - t1 + 2.0 * MARGIN)
+        } else {
+            (t2 - MARGIN, t1 + MARGIN, 2.0 - (t2 - t1) + 2.0 * MARGIN)
+        };
+        if len >= 2.0 - 2.0 / BUCKETS as f32 {
+            return all(out);
+        }
+        let wrap = |a: f32| {
+            if a < 0.0 {
+                a + 2.0
+            } else if a >= 2.0 {
+                a - 2.0
+            } else {
+                a
+            }
+        };
+        let (lo, hi) = (wrap(lo), wrap(hi));
+        let (bl, bh) = (bucket(lo), bucket(hi));
+        let w = self.words;
+        let (below_lo, upto_hi) = (
+            &self.prefix[bl * w..bl * w + w],
+            &self.prefix[(bh + 1) * w..(bh + 2) * w],
+        );
+        let mut any = 0u64;
+        for j in 0..w {
+            let range = if lo <= hi {
+                upto_hi[j] & !below_lo[j]
+            } else {
+                upto_hi[j] | !below_lo[j]
+            };
+            out[j] = range & allowed[j];
+            any |= out[j];
+        }
+        any != 0
+    }
+}

@@ -1,0 +1,270 @@
+//! Light-centred single-precision forms of the per-(pixel, edge) work of the wedge pass (DCS
+//! section 4.2), with exact double-precision fallbacks.
+//!
+//! Every quantity a pair needs is an affine or bilinear function of the view sample `p`; written
+//! relative to the light centre `c` (`x' = x - c`), so that it is as precise far from the origin
+//! as near it:
+//! * the wedge's bounding planes and the three planes through the edge's line that decide its
+//!   weight `k_e(p)`: through `c` (which side of the shadow-volume quad) and through each
+//!   adjacent face (is the edge a silhouette from `p`, does `p` see the face's back) are
+//!   evaluated in `f32` with an error bound; a value inside the bound sends the pixel to the
+//!   exact [`SceneEdge::sweep_weight`];
+//! * the covered-sample test ([`EdgeTest`]) needs one cross product per end point and one for
+//!   the edge: `(a - p) x (c - p) = p' x a'`, `(p - a) x (b - a) = p' x e - a' x b'`, with the
+//!   orientation `orient(a, b, p, c) = (p' x e) . a'` (in double precision, like
+//!   [`EdgeTest::new`], whose tie rule it keeps).
+
+use glam::{DVec3, Vec3};
+
+use crate::coverage::EdgeTest;
+use crate::edges::SceneEdge;
+
+/// Relative error bound of an `f32` plane evaluation, against `|n|_1 |x'|_1 + |d|`: far above
+/// the few roundings of a dot product.
+const PLANE_BOUND: f32 = 1e-5;
+
+/// An affine function `n . x' + d` of a light-centred point.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct CentredPlane {
+    n: Vec3,
+    d: f32,
+    /// `PLANE_BOUND |n|_1` and `PLANE_BOUND |d|`.
+    bound_n: f32,
+    bound_d: f32,
+}
+
+impl CentredPlane {
+    /// The plane `n . x + d` (world coordinates, double precision) around centre `c`.
+    pub fn new(n: DVec3, d: f64, c: DVec3) -> Self {
+        let scale = n.abs().max_element();
+        let (n, d) = if scale > 0.0 && scale.is_finite() {
+            (n / scale, (d + n.dot(c)) / scale)
+        } else {
+            (n, d + n.dot(c))
+        };
+        let (n, d) = (n.as_vec3(), d as f32);
+        Self {
+            n,
+            d,
+            bound_n: PLANE_BOUND * n.abs().element_sum(),
+            bound_d: PLANE_BOUND * d.abs(),
+        }
+    }
+
+    /// The value at the centred point `x`.
+    #[inline]
+    pub fn eval(&self, x: Vec3) -> f32 {
+        self.n.dot(x) + self.d
+    }
+
+    /// The largest value over the box `lo..hi`.
+    #[inline]
+    pub fn max_over(&self, lo: Vec3, hi: Vec3) -> f32 {
+        let x = Vec3::select(self.n.cmpgt(Vec3::ZERO), hi, lo);
+        self.eval(x)
+    }
+
+    /// The smallest value over the box `lo..hi`.
+    #[inline]
+    pub fn min_over(&self, lo: Vec3, hi: Vec3) -> f32 {
+        let x = Vec3::select(self.n.cmpgt(Vec3::ZERO), lo, hi);
+        self.eval(x)
+    }
+
+    /// The value at `x` when its sign is certain, given `x1 = |x|_1`; `None` near zero.
+    #[inline]
+    fn certain(&self, x: Vec3, x1: f32) -> Option<f32> {
+        let v = self.eval(x);
+        let bound = self.bound_n * x1 + self.bound_d;
+        (v.abs() > bound).then_some(v)
+    }
+}
+
+/// One adjacent face of an edge for the fast weight.
+#[derive(Debug, Clone, Copy)]
+struct FaceSign {
+    /// `N_f . (x - a)`, `N_f = (b - a) x (third - a)`.
+    plane: CentredPlane,
+    /// Whether the face's stored front side is where `plane` is positive.
+    front_positive: bool,
+    two_sided: bool,
+    weight: i64,
+}
+
+/// `k_e(p)` of an edge with one or two faces from three plane signs.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct FastWeight {
+    /// `N_c . (x - a)`, `N_c = (b - a) x (c - a)`.
+    through_center: CentredPlane,
+    faces: [Option<FaceSign>; 2],
+}
+
+impl FastWeight {
+    /// The fast weight of `e` around centre `c`; `None` for edges with more than two faces.
+    pub fn new(e: &SceneEdge, c: DVec3) -> Option<Self> {
+        if e.faces.is_empty() || e.faces.len() > 2 {
+            return None;
+        }
+        let ab = e.b - e.a;
+        let plane_through = |w: DVec3| {
+            let n = ab.cross(w - e.a);
+            CentredPlane::new(n, -n.dot(e.a), c)
+        };
+        let mut faces = [None; 2];
+        for (slot, f) in faces.iter_mut().zip(&e.faces) {
+            let n = ab.cross(f.third - e.a);
+            *slot = Some(FaceSign {
+                plane: plane_through(f.third),
+                front_positive: n.dot(f.normal) > 0.0,
+                two_sided: f.two_sided,
+                weight: f.weight as i64,
+            });
+        }
+        Some(Self {
+            through_center: plane_through(c),
+            faces,
+        })
+    }
+
+    /// `k_e` at the centred view sample `x` (`|x|_1 = x1`), the rule of
+    /// [`SceneEdge::sweep_weight`] from a view sample toward `c`; `None` when a sign is
+    /// uncertain (the caller then takes the exact weight).
+    #[inline]
+    pub fn weight(&self, x: Vec3, x1: f32) -> Option<i64> {
+        // sweep_weight's side of `from` = c is -N_c . (x - a); a face's side is -N_f . (x - a).
+        let from_negative = self.through_center.certain(x, x1)? < 0.0;
+        let mut k = 0;
+        for f in self.faces.iter().flatten() {
+            let v = f.plane.certain(x, x1)?;
+            let front = (v > 0.0) == f.front_positive;
+            // One-sided faces count only from behind.
+            if !f.two_sided && front {
+                continue;
+            }
+            if (v < 0.0) == from_negative {
+                k -= f.weight;
+            } else {
+                k += f.weight;
+            }
+        }
+        Some(k)
+    }
+}
+
+/// An edge relative to the light centre, for [`EdgeTest`]s from many view samples: three cross
+/// products per test instead of four, and no per-test differences of world positions.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct CentredEdge {
+    a: DVec3,
+    b: DVec3,
+    e: DVec3,
+    /// `a' x b'`.
+    ab: DVec3,
+    /// `(b - a) x (c - a)`.
+    h1: DVec3,
+}
+
+impl CentredEdge {
+    /// Edge `e` around centre `c`.
+    pub fn new(e: &SceneEdge, c: DVec3) -> Self {
+        let (a, b) = (e.a - c, e.b - c);
+        Self {
+            a,
+            b,
+            e: b - a,
+            ab: a.cross(b),
+            h1: (b - a).cross(-a),
+        }
+    }
+
+    /// The covered-sample test from the centred view sample `p`; `None` on the tie of
+    /// [`EdgeTest::new`] (the edge's line meets the line from `p` to `c`).
+    #[inline]
+    pub fn test(&self, p: DVec3) -> Option<EdgeTest> {
+        let u = p.cross(self.e);
+        let k0 = u.dot(self.a);
+        if k0 == 0.0 || !k0.is_finite() {
+            return None;
+        }
+        let ga = p.cross(self.a);
+        let gb = p.cross(self.b);
+        let k1 = self.h1.dot(p - self.a);
+        Some(EdgeTest::from_parts(
+            ga.as_vec3(),
+            gb.as_vec3(),
+            (u - self.ab).as_vec3(),
+            self.h1.as_vec3(),
+            k1 as f32,
+            k0 > 0.0,
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::edges::EdgeFace;
+    use shadow_core::sampling::{hash_words, unit_float};
+
+    fn face(a: DVec3, b: DVec3, third: DVec3, flip: bool, two_sided: bool) -> EdgeFace {
+        let (v0, v1, v2) = if flip { (a, third, b) } else { (a, b, third) };
+        let normal = (v1 - v0).cross(v2 - v0);
+        EdgeFace {
+            third,
+            normal,
+            offset: -normal.dot(v0),
+            weight: 1,
+            two_sided,
+        }
+    }
+
+    /// The single-precision weight and test agree with the double-precision ones wherever
+    /// they answer, far from the origin too, and answer almost everywhere.
+    #[test]
+    fn centred_forms_equal_the_exact_ones() {
+        let (mut answered, mut total, mut compared, mut differ) = (0, 0, 0, 0);
+        for (k, offset) in (0..3000u64).zip([0.0, 1e3, 1e5].into_iter().cycle()) {
+            let r = |i: u64| unit_float(hash_words(&[k, i])) as f64 * 2.0 - 1.0;
+            let o = DVec3::splat(offset);
+            let c = o + DVec3::new(r(0), 3.0 + r(1), r(2));
+            let a = o + DVec3::new(r(3), 1.0 + r(4) * 0.5, r(5));
+            let b = a + DVec3::new(r(6), r(7), r(8)) * 0.3;
+            let t1 = a + DVec3::new(r(9), r(10), r(11)) * 0.3;
+            let t2 = a + DVec3::new(r(12), r(13), r(14)) * 0.3;
+            let edge = SceneEdge {
+                a,
+                b,
+                faces: vec![
+                    face(a, b, t1, k % 2 == 0, k % 5 == 0),
+                    face(b, a, t2, k % 3 == 0, k % 5 == 0),
+                ],
+                always: false,
+            };
+            let p = o + DVec3::new(r(15) * 2.0, r(16) * 0.2, r(17) * 2.0);
+            let pc = (p - c).as_vec3();
+            let fast = FastWeight::new(&edge, c).unwrap();
+            total += 1;
+            if let Some(k) = fast.weight(pc, pc.abs().element_sum()) {
+                answered += 1;
+                assert_eq!(Some(k), edge.sweep_weight(p, c, false), "case {k}");
+            }
+            let centred = CentredEdge::new(&edge, c);
+            if let (Some(t), Some(exact)) = (centred.test(p - c), EdgeTest::new(p, c, a, b)) {
+                // Same covered samples on a grid of light points.
+                for j in 0..64 {
+                    let s =
+                        c + DVec3::new((j % 8) as f64 / 4.0 - 0.9, 0.0, (j / 8) as f64 / 4.0 - 0.9);
+                    let d = (s - p).as_vec3();
+                    compared += 1;
+                    differ += usize::from(t.covers_offset(d) != exact.covers_offset(d));
+                }
+            }
+        }
+        assert!(answered * 100 > total * 99, "{answered} of {total}");
+        // Rounding may only flip samples within about 1e-6 of an edge's boundary.
+        assert!(
+            compared > 100_000 && differ * 10_000 <= compared,
+            "{differ} of {compared}"
+        );
+    }
+}
