@@ -39,11 +39,7 @@ pub(crate) struct AngularIndex {
 /// through the origin along `(x, y)`; 0 for the zero vector.
 #[inline]
 fn line_angle(x: f32, y: f32) -> f32 {
-    let (x, y) = if y < 0.0 || (y == 0.0 && x < 0.0) {
-        (-x, -y)
-    } else {
-        (x, y)
-    };
+    let (x, y) = canonical(x, y);
     let r = x.abs() + y;
     if !(r > 0.0) {
         return 0.0;
@@ -58,7 +54,8 @@ fn bucket(a: f32) -> usize {
     ((a * (BUCKETS as f32 * 0.5)) as usize).min(BUCKETS - 1)
 }
 
-/// The direction `d` flipped, if needed, onto the half-plane [`line_angle`] measures from.
+/// The direction `(x, y)` flipped, if needed, onto the half-plane [`line_angle`] measures in
+/// (`y > 0`, or `y = 0` and `x >= 0`).
 #[inline]
 fn canonical(x: f32, y: f32) -> (f32, f32) {
     if y < 0.0 || (y == 0.0 && x < 0.0) {
@@ -101,8 +98,8 @@ impl AngularIndex {
             allowed.iter().any(|w| *w != 0)
         };
         // A sector plane (nearly) parallel to the light plane: leave it to the exact test.
-        let (la, lb) = ((ax * ax + ay * ay).sqrt(), (bx * bx + by * by).sqrt());
-        if !(la > 1e-4 * ga.length() && lb > 1e-4 * gb.length()) {
+        let (la2, lb2) = (ax * ax + ay * ay, bx * bx + by * by);
+        if !(la2 > 1e-8 * ga.length_squared() && lb2 > 1e-8 * gb.length_squared()) {
             return all(out);
         }
         // Directions of the two boundary lines (perpendicular to the in-plane normals).
@@ -110,11 +107,15 @@ impl AngularIndex {
         let (dbx, dby) = canonical(-by, bx);
         let (ta, tb) = (line_angle(dax, day), line_angle(dbx, dby));
         let (t1, t2) = (ta.min(tb), ta.max(tb));
-        // Between the two directions (the arc [t1, t2]): do the two tests differ there?
-        let (mx, my) = (dax / la + dbx / lb, day / la + dby / lb);
+        // Between the two directions (the arc [t1, t2], where any positive combination of the
+        // two half-plane directions lies): do the two tests differ there? The lengths are
+        // balanced so that neither direction dominates, and nearly parallel or opposite
+        // directions (an uncertain sign) leave the choice to the exact test.
+        let (wa, wb) = (lb2.sqrt(), la2.sqrt());
+        let (mx, my) = (dax * wa + dbx * wb, day * wa + dby * wb);
         let (sa, sb) = (ax * mx + ay * my, bx * mx + by * my);
-        let mlen = (mx * mx + my * my).sqrt();
-        if !(sa.abs() > 1e-3 * la * mlen && sb.abs() > 1e-3 * lb * mlen) {
+        let m2 = mx * mx + my * my;
+        if !(sa * sa > 1e-6 * la2 * m2 && sb * sb > 1e-6 * lb2 * m2) {
             return all(out);
         }
         // The sector's interval, forward from `lo` to `hi` (circularly), widened.
@@ -153,5 +154,70 @@ impl AngularIndex {
             any |= out[j];
         }
         any != 0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::coverage::RelativeSamples;
+    use crate::light_shape::LightShape;
+    use glam::DVec3;
+    use shadow_core::light::AreaLight;
+    use shadow_core::light::{Radiance, RectLight};
+    use shadow_core::sampling::{LightSampler, SamplingStrategy, hash_words, unit_float};
+
+    /// The candidates hold every sample the exact test covers, and leave most uncovered
+    /// samples out.
+    #[test]
+    fn candidates_hold_every_covered_sample() {
+        let light = RectLight::facing(
+            Vec3::new(0.2, 3.0, -0.1),
+            Vec3::NEG_Y,
+            1.2,
+            0.8,
+            Radiance::constant(Vec3::ONE).unwrap(),
+        )
+        .unwrap();
+        let shape = LightShape::new(&light, "test").unwrap();
+        let plane = shape.plane.clone().unwrap();
+        let sampler = LightSampler::new(SamplingStrategy::Stratified, 128, 3).unwrap();
+        let c = shape.center.as_dvec3();
+        let (mut units, mut rel, mut index) = (
+            Vec::new(),
+            RelativeSamples::default(),
+            AngularIndex::default(),
+        );
+        let (mut covered, mut candidates, mut total) = (0u32, 0u32, 0u32);
+        for k in 0..3000u64 {
+            let r = |i: u64| unit_float(hash_words(&[k, i])) as f64 * 2.0 - 1.0;
+            let p = DVec3::new(r(0) * 2.0, 0.0, r(1) * 2.0);
+            let mid = DVec3::new(r(2), 1.5 + r(3), r(4));
+            let dir = DVec3::new(r(5), r(6) * 0.3, r(7)) * 0.3 * r(8).abs();
+            let Some(test) = EdgeTest::new(p, c, mid - dir, mid + dir) else {
+                continue;
+            };
+            sampler.unit_samples(glam::UVec2::new(k as u32, 7), &mut units);
+            let pos: Vec<Vec3> = units.iter().map(|u| light.sample(*u).position).collect();
+            rel.set(p.as_vec3(), &pos);
+            index.build(&plane, shape.center, &pos);
+            let allowed = [u64::MAX; 2];
+            let (mut exact, mut cand) = ([0u64; 2], [0u64; 2]);
+            test.mask(&rel, &allowed, &mut exact);
+            index.candidates(&test, &allowed, &mut cand);
+            for w in 0..2 {
+                assert_eq!(
+                    exact[w] & !cand[w],
+                    0,
+                    "case {k}: a covered sample is no candidate"
+                );
+                covered += exact[w].count_ones();
+                candidates += cand[w].count_ones();
+            }
+            total += 128;
+        }
+        assert!(covered > 1000, "{covered}");
+        // The double cone holds about twice the covered samples, far fewer than all.
+        assert!(candidates < total / 4, "{candidates} of {total}");
     }
 }

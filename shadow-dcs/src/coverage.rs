@@ -303,3 +303,56 @@ mod tests {
         assert_eq!(agree, n * n);
     }
 }
+
+#[cfg(test)]
+mod light_overlap_tests {
+    use super::*;
+    use shadow_core::sampling::{hash_words, unit_float};
+
+    /// `may_cover` never rejects an edge that covers a light point (a dense grid over a
+    /// rectangle light, edges from random view samples, some far from the origin), and it
+    /// rejects most edges that cover none.
+    #[test]
+    fn light_overlap_test_is_conservative_and_useful() {
+        let (mut covering, mut rejected_empty, mut empty) = (0, 0, 0);
+        for k in 0..4000u64 {
+            let r = |i: u64| unit_float(hash_words(&[k, i])) as f64 * 2.0 - 1.0;
+            let offset = DVec3::splat([0.0, 1e4][k as usize % 2]);
+            let c = offset + DVec3::new(0.0, 3.0, 0.0);
+            let (hu, hv) = (0.3 + 0.2 * r(0).abs(), 0.2 + 0.3 * r(1).abs());
+            let corners = [(-hu, -hv), (hu, -hv), (hu, hv), (-hu, hv)]
+                .map(|(x, z)| c + DVec3::new(x, 0.0, z));
+            let p = offset + DVec3::new(r(2) * 2.0, 0.0, r(3) * 2.0);
+            let mid = offset + DVec3::new(r(4), 1.0 + r(5).abs(), r(6));
+            let dir = DVec3::new(r(7), r(8) * 0.2, r(9)) * 0.2 * r(10).abs();
+            let (a, b) = (mid - dir, mid + dir);
+            let Some(t) = EdgeTest::new(p, c, a, b) else {
+                continue;
+            };
+            let polygon: Vec<Vec3> = corners.iter().map(|v| (*v - p).as_vec3()).collect();
+            let n = 48;
+            let covers = (0..n * n).any(|j| {
+                let s = c + DVec3::new(
+                    hu * (2.0 * ((j % n) as f64 + 0.5) / n as f64 - 1.0),
+                    0.0,
+                    hv * (2.0 * ((j / n) as f64 + 0.5) / n as f64 - 1.0),
+                );
+                t.covers_offset((s - p).as_vec3())
+            });
+            let kept = t.may_cover(&polygon);
+            if covers {
+                covering += 1;
+                assert!(kept, "case {k}: a covering edge was rejected");
+            } else {
+                empty += 1;
+                rejected_empty += usize::from(!kept);
+            }
+        }
+        assert!(covering > 100, "{covering}");
+        // Grid points miss thin slivers, so a kept "empty" edge may still cover the light.
+        assert!(
+            rejected_empty * 10 > empty * 8,
+            "{rejected_empty} of {empty}"
+        );
+    }
+}

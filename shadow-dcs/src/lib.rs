@@ -9,7 +9,12 @@
 //! * [`edges`]: scene edges, weights and accurate or standard silhouette detection (section 4.1);
 //! * [`constant`]: the integration constant by the shadow-volume step (section 4.1);
 //! * [`wedges`]: the view samples inside each penumbra wedge (section 4.2);
-//! * [`coverage`]: the light samples an edge covers, exactly (Algorithm 1, Fig. 2);
+//! * [`coverage`]: the light samples an edge covers, exactly (Algorithm 1, Fig. 2), and the
+//!   exact test that an edge seen from a pixel covers part of a planar light at all;
+//! * `angular` (internal): a per-pixel angular index of the light samples that finds each
+//!   edge's candidate samples with two lookups (section 7.3's sector table, per pixel);
+//! * `centred` (internal): the per-(pixel, edge) tests in light-centred single precision, with
+//!   exact fallbacks;
 //! * [`discrete`]: the sector and line tables of section 7.3 (Fig. 8);
 //! * [`counters`]: packed counters with overflow detection (sections 4.3, 4.4, 5.3);
 //! * [`technique`]: the [`Dcs`] technique; [`presets`] registers its configurations.
