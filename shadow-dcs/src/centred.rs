@@ -18,6 +18,7 @@ use glam::{DVec3, Vec3};
 
 use crate::coverage::EdgeTest;
 use crate::edges::SceneEdge;
+use crate::lanes::{LANES, LaneMask, Lanes, TileLanes, above_bound, non_negative};
 
 /// Relative error bound of an `f32` plane evaluation, against `|n|_1 |x'|_1 + |d|`: far above
 /// the few roundings of a dot product.
@@ -57,6 +58,38 @@ impl CentredPlane {
         self.n.dot(x) + self.d
     }
 
+    /// The values at every lane of a tile (the order of operations of [`Self::eval`]).
+    #[inline]
+    pub fn eval_lanes(&self, t: &TileLanes, out: &mut Lanes) {
+        for j in 0..LANES {
+            out[j] = self.n.x * t.x[j] + self.n.y * t.y[j] + self.n.z * t.z[j] + self.d;
+        }
+    }
+
+    /// The lanes of a tile that no plane of `planes` puts on its negative side (a NaN value
+    /// rejects nothing, as in a scalar `eval(x) < 0` test).
+    #[inline]
+    pub fn inside_all(planes: &[Self], t: &TileLanes) -> LaneMask {
+        let mut low = [f32::INFINITY; LANES];
+        let mut v = [0.0f32; LANES];
+        for p in planes {
+            p.eval_lanes(t, &mut v);
+            for j in 0..LANES {
+                low[j] = low[j].min(v[j]);
+            }
+        }
+        non_negative(&low)
+    }
+
+    /// The error bounds of [`Self::eval_lanes`] at every lane: a value whose magnitude exceeds
+    /// its bound has a certain sign.
+    #[inline]
+    fn bound_lanes(&self, t: &TileLanes, out: &mut Lanes) {
+        for j in 0..LANES {
+            out[j] = self.bound_n * t.l1[j] + self.bound_d;
+        }
+    }
+
     /// The largest value over the box `lo..hi`.
     #[inline]
     pub fn max_over(&self, lo: Vec3, hi: Vec3) -> f32 {
@@ -69,14 +102,6 @@ impl CentredPlane {
     pub fn min_over(&self, lo: Vec3, hi: Vec3) -> f32 {
         let x = Vec3::select(self.n.cmpgt(Vec3::ZERO), lo, hi);
         self.eval(x)
-    }
-
-    /// The value at `x` when its sign is certain, given `x1 = |x|_1`; `None` near zero.
-    #[inline]
-    fn certain(&self, x: Vec3, x1: f32) -> Option<f32> {
-        let v = self.eval(x);
-        let bound = self.bound_n * x1 + self.bound_d;
-        (v.abs() > bound).then_some(v)
     }
 }
 
@@ -125,29 +150,52 @@ impl FastWeight {
             faces,
         })
     }
+}
 
-    /// `k_e` at the centred view sample `x` (`|x|_1 = x1`), the rule of
-    /// [`SceneEdge::sweep_weight`] from a view sample toward `c`; `None` when a sign is
-    /// uncertain (the caller then takes the exact weight).
+/// `k_e` at every lane of a tile, with the mask of lanes whose signs are all certain; lanes
+/// outside it must take the exact weight. Face weights are at most [`LANE_WEIGHT_MAX`], so
+/// that a lane's sum cannot overflow.
+pub(crate) struct LaneWeights {
+    pub k: [i32; LANES],
+    pub certain: LaneMask,
+}
+
+/// The largest face weight the lane form takes (larger ones go through the exact weight).
+const LANE_WEIGHT_MAX: i64 = 1 << 29;
+
+impl FastWeight {
+    /// `k_e` at every lane of a tile by the rule of [`SceneEdge::sweep_weight`] from a view
+    /// sample toward `c`: that rule's side of `c` is the sign of `-N_c . (x - a)` and a face's
+    /// side that of `-N_f . (x - a)`; a one-sided face counts only from behind. `None` when a
+    /// face weight exceeds [`LANE_WEIGHT_MAX`].
     #[inline]
-    pub fn weight(&self, x: Vec3, x1: f32) -> Option<i64> {
-        // sweep_weight's side of `from` = c is -N_c . (x - a); a face's side is -N_f . (x - a).
-        let from_negative = self.through_center.certain(x, x1)? < 0.0;
-        let mut k = 0;
+    pub fn weight_lanes(&self, t: &TileLanes) -> Option<LaneWeights> {
+        let (mut v, mut bound) = ([0.0f32; LANES], [0.0f32; LANES]);
+        self.through_center.eval_lanes(t, &mut v);
+        self.through_center.bound_lanes(t, &mut bound);
+        let mut certain = above_bound(&v, &bound);
+        let from_negative = v;
+        let mut k = [0i32; LANES];
         for f in self.faces.iter().flatten() {
-            let v = f.plane.certain(x, x1)?;
-            let front = (v > 0.0) == f.front_positive;
-            // One-sided faces count only from behind.
-            if !f.two_sided && front {
-                continue;
+            if f.weight > LANE_WEIGHT_MAX {
+                return None;
             }
-            if (v < 0.0) == from_negative {
-                k -= f.weight;
-            } else {
-                k += f.weight;
+            let w = f.weight as i32;
+            f.plane.eval_lanes(t, &mut v);
+            f.plane.bound_lanes(t, &mut bound);
+            certain &= above_bound(&v, &bound);
+            for j in 0..LANES {
+                let front = (v[j] > 0.0) == f.front_positive;
+                let counts = f.two_sided || !front;
+                let s = if (v[j] < 0.0) == (from_negative[j] < 0.0) {
+                    -w
+                } else {
+                    w
+                };
+                k[j] += if counts { s } else { 0 };
             }
         }
-        Some(k)
+        Some(LaneWeights { k, certain })
     }
 }
 
@@ -204,6 +252,7 @@ impl CentredEdge {
 mod tests {
     use super::*;
     use crate::edges::EdgeFace;
+    use crate::lanes::{BAND_ROWS, TILE_W, band_lanes};
     use shadow_core::sampling::{hash_words, unit_float};
 
     fn face(a: DVec3, b: DVec3, third: DVec3, flip: bool, two_sided: bool) -> EdgeFace {
@@ -216,6 +265,57 @@ mod tests {
             weight: 1,
             two_sided,
         }
+    }
+
+    /// On full tiles every lane with certain signs gets the exact weight, whatever its
+    /// neighbours, and almost every lane is certain.
+    #[test]
+    fn lane_weights_equal_the_exact_weight_on_full_tiles() {
+        let (mut certain, mut total) = (0, 0);
+        for k in 0..400u64 {
+            let r = |i: u64| unit_float(hash_words(&[k, i])) as f64 * 2.0 - 1.0;
+            let c = DVec3::new(r(0), 3.0 + r(1), r(2));
+            let a = DVec3::new(r(3), 1.0 + r(4) * 0.5, r(5));
+            let b = a + DVec3::new(r(6), r(7), r(8)) * 0.3;
+            let t1 = a + DVec3::new(r(9), r(10), r(11)) * 0.3;
+            let t2 = a + DVec3::new(r(12), r(13), r(14)) * 0.3;
+            let edge = SceneEdge {
+                a,
+                b,
+                faces: vec![
+                    face(a, b, t1, k % 2 == 0, k % 3 == 0),
+                    face(b, a, t2, k % 4 < 2, k % 3 == 0),
+                ],
+                always: false,
+            };
+            let points: Vec<DVec3> = (0..LANES as u64)
+                .map(|j| {
+                    DVec3::new(
+                        r(20 + 3 * j) * 2.0,
+                        r(21 + 3 * j) * 0.2,
+                        r(22 + 3 * j) * 2.0,
+                    )
+                })
+                .collect();
+            let centred: Vec<Vec3> = points.iter().map(|p| (*p - c).as_vec3()).collect();
+            let tile = band_lanes(TILE_W, (0, BAND_ROWS - 1), &centred, &[true; LANES])[0];
+            let lanes = FastWeight::new(&edge, c)
+                .unwrap()
+                .weight_lanes(&tile)
+                .unwrap();
+            for (j, p) in points.iter().enumerate() {
+                total += 1;
+                if lanes.certain >> j & 1 == 1 {
+                    certain += 1;
+                    assert_eq!(
+                        Some(i64::from(lanes.k[j])),
+                        edge.sweep_weight(*p, c, false),
+                        "case {k} lane {j}"
+                    );
+                }
+            }
+        }
+        assert!(certain * 100 > total * 99, "{certain} of {total}");
     }
 
     /// The single-precision weight and test agree with the double-precision ones wherever
@@ -244,8 +344,10 @@ mod tests {
             let pc = (p - c).as_vec3();
             let fast = FastWeight::new(&edge, c).unwrap();
             total += 1;
-            if let Some(k) = fast.weight(pc, pc.abs().element_sum()) {
+            let lanes = fast.weight_lanes(&TileLanes::at(pc)).unwrap();
+            if lanes.certain & 1 == 1 {
                 answered += 1;
+                let k = i64::from(lanes.k[0]);
                 assert_eq!(Some(k), edge.sweep_weight(p, c, false), "case {k}");
             }
             let centred = CentredEdge::new(&edge, c);

@@ -101,7 +101,7 @@ pub(crate) fn integration_constants(
         let l = d.length();
         (l > 0.0).then(|| cd + d * (far_radius / l))
     };
-    type Quad = (Vec<Vec3>, i64, [DVec3; 3], bool);
+    type Quad = (Vec<Vec3>, i64, DVec3, bool);
     let quads: Vec<Quad> = silhouettes
         .iter()
         .filter_map(|&i| {
@@ -122,7 +122,8 @@ pub(crate) fn integration_constants(
             Some((
                 poly.iter().map(|v| v.as_vec3()).collect(),
                 k,
-                [cd, e.a, e.b],
+                // orient(c, a, b, x) = normal . (x - c), the normal computed once.
+                (e.a - cd).cross(e.b - cd),
                 eye_side > 0.0,
             ))
         })
@@ -130,18 +131,22 @@ pub(crate) fn integration_constants(
     let near_view = near_zero(view, far_radius);
     let w = view.width as usize;
     let n = origins.len();
+    // A few large chunks: each holds one accumulator image.
+    let chunk = quads
+        .len()
+        .div_ceil(2 * rayon::current_num_threads())
+        .max(1);
     let sums = quads
-        .par_iter()
-        .fold(
-            || vec![0i64; n],
-            |mut acc, (q, k, plane, eye_positive)| {
+        .par_chunks(chunk)
+        .map(|quads| {
+            let mut acc = vec![0i64; n];
+            for (q, k, normal, eye_positive) in quads {
                 let mut visit = |x: u32, y: u32| {
                     let i = y as usize * w + x as usize;
                     if !valid[i] {
                         return;
                     }
-                    let side =
-                        super::edges::orient(plane[0], plane[1], plane[2], origins[i].as_dvec3());
+                    let side = normal.dot(origins[i].as_dvec3() - cd);
                     if side != 0.0 && (side > 0.0) != *eye_positive {
                         acc[i] += k;
                     }
@@ -149,9 +154,9 @@ pub(crate) fn integration_constants(
                 for j in 1..q.len() - 1 {
                     for_each_covered_pixel(&near_view, [q[0], q[j], q[j + 1]], &mut visit);
                 }
-                acc
-            },
-        )
+            }
+            acc
+        })
         .reduce(
             || vec![0i64; n],
             |mut a, b| {

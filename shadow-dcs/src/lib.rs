@@ -41,6 +41,7 @@ pub mod counters;
 pub mod coverage;
 pub mod discrete;
 pub mod edges;
+mod lanes;
 mod light_shape;
 mod presets;
 pub mod technique;

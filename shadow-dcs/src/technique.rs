@@ -40,8 +40,9 @@ use crate::counters::{Packed, WIDTHS, width_for};
 use crate::coverage::{EdgeTest, RelativeSamples};
 use crate::discrete::{CoveredSamples, DiscreteTables};
 use crate::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
+use crate::lanes::BAND_ROWS;
 use crate::light_shape::LightShape;
-use crate::wedges::{Pair, Region, band_pairs, wedge_regions};
+use crate::wedges::{Pair, Region, band_pairs, region_rows, wedge_regions};
 
 /// What per-sample visibility an estimate returns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -103,6 +104,8 @@ struct Frame<'a> {
     active: Vec<bool>,
     constants: Vec<i64>,
     regions: Vec<Region>,
+    /// The rows of each region.
+    region_rows: Vec<(u32, u32)>,
     bits: u32,
     view: &'a ViewSamples,
 }
@@ -110,10 +113,6 @@ struct Frame<'a> {
 /// Candidates up to which an edge's samples are tested one by one rather than a whole word
 /// at a time.
 const FEW_CANDIDATES: u32 = 12;
-
-/// Rows per band: wedge pairs exist for one band at a time, which bounds their memory on scenes
-/// of very high depth complexity (`grass`).
-const BAND_ROWS: u32 = 4;
 
 /// Where the light lies relative to a receiver's tangent plane.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -258,18 +257,16 @@ impl Dcs {
                 .into(),
         })?;
         let n = view.len();
-        let origins: Vec<Vec3> = (0..n)
+        let (origins, horizon): (Vec<Vec3>, Vec<Horizon>) = (0..n)
+            .into_par_iter()
             .map(|i| match view.get(i) {
-                Some(s) => p.offset.offset(s.position, s.geometric_normal),
-                None => Vec3::ZERO,
+                Some(s) => {
+                    let o = p.offset.offset(s.position, s.geometric_normal);
+                    (o, Self::horizon(&p.shape, &s, o))
+                }
+                None => (Vec3::ZERO, Horizon::Below),
             })
-            .collect();
-        let horizon: Vec<Horizon> = (0..n)
-            .map(|i| match view.get(i) {
-                Some(s) => Self::horizon(&p.shape, &s, origins[i]),
-                None => Horizon::Below,
-            })
-            .collect();
+            .unzip();
         let active: Vec<bool> = horizon.iter().map(|h| *h != Horizon::Below).collect();
         let c = p.shape.center;
         let (constants, quads) = stats.time("shadow-volumes", || {
@@ -301,10 +298,11 @@ impl Dcs {
             )
         });
         stats.add("wedges", regions.len() as u64);
+        let region_rows = region_rows(&regions);
         stats.add("wedges-unbounded", unbounded);
         let cd = p.shape.center.as_dvec3();
         let centred = origins
-            .iter()
+            .par_iter()
             .map(|o| (o.as_dvec3() - cd).as_vec3())
             .collect();
         Ok(Frame {
@@ -314,6 +312,7 @@ impl Dcs {
             active,
             constants,
             regions,
+            region_rows,
             bits,
             view,
         })
@@ -334,6 +333,7 @@ impl Dcs {
         let pairs = band_pairs(
             &p.edges,
             &f.regions,
+            &f.region_rows,
             p.shape.center.as_dvec3(),
             view.raster_view(),
             rows,

@@ -18,6 +18,7 @@ use shadow_core::raster::RasterView;
 
 use crate::centred::{CentredPlane, FastWeight};
 use crate::edges::SceneEdge;
+use crate::lanes::{TILE_W, TileLanes, band_lanes, lanes_of, span_mask};
 use crate::light_shape::LightShape;
 
 /// One (pixel, silhouette edge) pair: the edge and its weight `k_e(p)`.
@@ -200,9 +201,6 @@ fn fold_possible_in(f: &(CentredPlane, CentredPlane), lo: Vec3, hi: Vec3, slack:
     (max1 > -slack && max2 > -slack) || (min1 < slack && min2 < slack)
 }
 
-/// Per-tile bounds of the active view samples: tiles of [`TILE_W`] columns by one band of rows.
-pub(crate) const TILE_W: u32 = 4;
-
 /// Tiles per group: a group's box is tested before its tiles'.
 const GROUP: usize = 8;
 
@@ -218,33 +216,6 @@ fn union_boxes(boxes: &[TileBox]) -> TileBox {
 
 /// `None` for a tile with no active view sample; light-centred coordinates.
 pub(crate) type TileBox = Option<(Vec3, Vec3)>;
-
-/// The bounds of every tile of a band, from the light-centred view samples.
-fn band_tiles(
-    view: &RasterView,
-    rows: (u32, u32),
-    centred: &[Vec3],
-    active: &[bool],
-) -> Vec<TileBox> {
-    let w = view.width as usize;
-    let tiles = view.width.div_ceil(TILE_W) as usize;
-    let mut out: Vec<TileBox> = vec![None; tiles];
-    for y in rows.0..=rows.1 {
-        for x in 0..w {
-            let i = y as usize * w + x;
-            if !active[i] {
-                continue;
-            }
-            let p = centred[i];
-            let t = &mut out[x / TILE_W as usize];
-            *t = Some(match *t {
-                Some((lo, hi)) => (lo.min(p), hi.max(p)),
-                None => (p, p),
-            });
-        }
-    }
-    out
-}
 
 /// The screen regions of every silhouette edge's wedge, in edge order (empty regions dropped).
 /// The number of unbounded wedges (scanned over the whole image) is returned too.
@@ -298,6 +269,12 @@ pub(crate) fn wedge_regions(
     (regions, unbounded)
 }
 
+/// The rows of every region, compactly, so that a band finds its regions without touching the
+/// others.
+pub(crate) fn region_rows(regions: &[Region]) -> Vec<(u32, u32)> {
+    regions.iter().map(|r| r.rows).collect()
+}
+
 /// The pairs of rows `rows` (a band): every region overlapping the band is scanned there (its
 /// screen polygon's column range over the band's rows, tile by tile, skipping tiles whose view
 /// samples' box lies outside the wedge's planes or where the edge cannot be a silhouette), and
@@ -306,6 +283,7 @@ pub(crate) fn wedge_regions(
 pub(crate) fn band_pairs(
     edges: &[SceneEdge],
     regions: &[Region],
+    all_rows: &[(u32, u32)],
     c: DVec3,
     view: &RasterView,
     rows: (u32, u32),
@@ -319,7 +297,8 @@ pub(crate) fn band_pairs(
     let n = (rows.1 - rows.0 + 1) as usize * w;
     let mut found: Vec<(u32, Pair)> = Vec::new();
     let mut scanned = 0u64;
-    let tiles = band_tiles(view, rows, centred, active);
+    let lanes = band_lanes(view.width, rows, centred, active);
+    let tiles: Vec<TileBox> = lanes.iter().map(TileLanes::bounds).collect();
     let groups: Vec<TileBox> = tiles.chunks(GROUP).map(union_boxes).collect();
     let band_box = union_boxes(&groups);
     let slack = (FOLD_SLACK * scale) as f32;
@@ -337,10 +316,12 @@ pub(crate) fn band_pairs(
                 .as_ref()
                 .is_some_and(|f| !fold_possible_in(f, lo, hi, slack))
     };
-    for r in regions {
-        if r.rows.1 < rows.0 || r.rows.0 > rows.1 {
-            continue;
-        }
+    for (ri, _) in all_rows
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.1 >= rows.0 && r.0 <= rows.1)
+    {
+        let r = &regions[ri];
         if rejects(r, band_lo, band_hi) {
             continue;
         }
@@ -360,42 +341,41 @@ pub(crate) fn band_pairs(
                 t = (g as u32 + 1) * GROUP as u32;
                 continue;
             }
-            let tile = tiles[t as usize];
+            let tc = t;
             t += 1;
-            let Some((lo, hi)) = tile else {
+            let Some((lo, hi)) = tiles[tc as usize] else {
                 continue;
             };
             if rejects(r, lo, hi) {
                 continue;
             }
-            let tc = t - 1;
-            let (c0, c1) = (
-                (tc * TILE_W).max(xmin),
-                (tc * TILE_W + TILE_W - 1).min(xmax),
+            let tile = &lanes[tc as usize];
+            let x0 = tc * TILE_W;
+            let span = span_mask(
+                xmin.max(x0) - x0,
+                xmax.min(x0 + TILE_W - 1) - x0,
+                y0 - rows.0,
+                y1 - rows.0,
             );
-            for y in y0..=y1 {
-                for x in c0..=c1 {
-                    let i = y as usize * w + x as usize;
-                    scanned += 1;
-                    if !active[i] {
-                        continue;
-                    }
-                    let x = centred[i];
-                    if r.centred_planes.iter().any(|p| p.eval(x) < 0.0) {
-                        continue;
-                    }
-                    let fast = r
-                        .weight
-                        .as_ref()
-                        .and_then(|f| f.weight(x, x.abs().element_sum()));
-                    let Some(k) = fast.or_else(|| e.sweep_weight(origins[i].as_dvec3(), c, false))
-                    else {
-                        continue;
-                    };
-                    if k != 0 {
-                        let k = k.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
-                        found.push(((i - first) as u32, Pair { edge: r.edge, k }));
-                    }
+            scanned += u64::from(span.count_ones());
+            let inside = span & tile.active & CentredPlane::inside_all(&r.centred_planes, tile);
+            if inside == 0 {
+                continue;
+            }
+            let fast = r.weight.as_ref().and_then(|f| f.weight_lanes(tile));
+            for j in lanes_of(inside) {
+                let i =
+                    (rows.0 + j as u32 / TILE_W) as usize * w + (x0 + j as u32 % TILE_W) as usize;
+                let k = match &fast {
+                    Some(f) if f.certain >> j & 1 == 1 => i64::from(f.k[j]),
+                    _ => match e.sweep_weight(origins[i].as_dvec3(), c, false) {
+                        Some(k) => k,
+                        None => continue,
+                    },
+                };
+                if k != 0 {
+                    let k = k.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+                    found.push(((i - first) as u32, Pair { edge: r.edge, k }));
                 }
             }
         }
@@ -432,8 +412,9 @@ fn band_span(poly: &[DVec2], y0: u32, y1: u32, width: u32) -> Option<(u32, u32)>
     }
     let (ylo, yhi) = (y0 as f64 + 0.5 - PAD, y1 as f64 + 0.5 + PAD);
     let (mut xl, mut xr) = (f64::INFINITY, f64::NEG_INFINITY);
-    for i in 0..n {
-        let (a, b) = (poly[i], poly[(i + 1) % n]);
+    let mut prev = poly[n - 1];
+    for &b in poly {
+        let a = std::mem::replace(&mut prev, b);
         let (top, bottom) = (a.y.min(b.y), a.y.max(b.y));
         if bottom < ylo || top > yhi {
             continue;
