@@ -3,24 +3,27 @@
 //! stratified and decorrelated sampling, and used only to find candidates: the exact test of
 //! [`crate::coverage`] still decides every candidate.
 //!
-//! The samples an edge covers lie in its angular sector around the light centre `c`, between
-//! the lines where the planes `(p, c, a)` and `(p, c, b)` cut the light plane (Algorithm 1,
-//! lines 4-5). Each sample is put in one of [`BUCKETS`] buckets by the direction of the line
-//! from `c` through it (an angle modulo `pi`, so the double cone where the two orientation
-//! tests differ is one circular interval); prefix masks over the buckets then give, with two
-//! loads and two bit operations, every sample whose direction lies in the sector's interval
-//! widened by [`MARGIN`]. Most wedge pairs of a finely tessellated mesh have thin sectors
-//! holding no sample at all and are dropped without a per-sample test.
+//! The samples an edge covers lie in its angular sector around the light centre `c`: one cone
+//! between the lines where the planes `(p, c, a)` and `(p, c, b)` cut the light plane
+//! (Algorithm 1, lines 4-5), the one [`EdgeTest`] orients its sector normals toward. Each
+//! sample is put in one of [`BUCKETS`] buckets by the direction from `c` to it (over a whole
+//! turn); prefix masks over the buckets then give, with two loads and two bit operations, every
+//! sample whose direction lies in the cone's arc widened by [`MARGIN`]. Most wedge pairs of a
+//! finely tessellated mesh have thin sectors holding no sample at all and are dropped without a
+//! per-sample test.
 
 use glam::Vec3;
 
 use crate::coverage::EdgeTest;
 use crate::light_shape::LightPlane;
 
-/// Angular buckets over a half turn.
-pub(crate) const BUCKETS: usize = 128;
+/// Angular buckets over a whole turn.
+pub(crate) const BUCKETS: usize = 256;
 
-/// Widening of a sector's interval, in pseudo-angle units (a half turn is 2): far above the
+/// Pseudo-angle of a whole turn (see [`direction_angle`]).
+const TURN: f32 = 4.0;
+
+/// Widening of a sector's arc, in pseudo-angle units (a quarter turn is 1): far above the
 /// rounding of the directions, so that no sample the exact test covers is left out.
 const MARGIN: f32 = 1e-3;
 
@@ -35,34 +38,28 @@ pub(crate) struct AngularIndex {
     prefix: Vec<u64>,
 }
 
-/// A direction's angle modulo a half turn, as a monotone pseudo-angle in `[0, 2)`: the line
-/// through the origin along `(x, y)`; 0 for the zero vector.
+/// The direction of `(x, y)` as a monotone pseudo-angle in `[0, 4)` (the "diamond angle": 0
+/// along +x, 1 along +y, 2 along -x, 3 along -y); 0 for the zero vector.
 #[inline]
-fn line_angle(x: f32, y: f32) -> f32 {
-    let (x, y) = canonical(x, y);
-    let r = x.abs() + y;
+fn direction_angle(x: f32, y: f32) -> f32 {
+    let r = x.abs() + y.abs();
     if !(r > 0.0) {
         return 0.0;
     }
-    // 1 - x / r runs from 0 (along +x) to 2 (along -x, excluded).
-    (1.0 - x / r).clamp(0.0, 2.0)
+    let a = if y >= 0.0 {
+        if x >= 0.0 { y / r } else { 1.0 - x / r }
+    } else if x < 0.0 {
+        2.0 - y / r
+    } else {
+        3.0 + x / r
+    };
+    if a < TURN { a.max(0.0) } else { 0.0 }
 }
 
-/// The bucket of a pseudo-angle in `[0, 2)`.
+/// The bucket of a pseudo-angle in `[0, 4)`.
 #[inline]
 fn bucket(a: f32) -> usize {
-    ((a * (BUCKETS as f32 * 0.5)) as usize).min(BUCKETS - 1)
-}
-
-/// The direction `(x, y)` flipped, if needed, onto the half-plane [`line_angle`] measures in
-/// (`y > 0`, or `y = 0` and `x >= 0`).
-#[inline]
-fn canonical(x: f32, y: f32) -> (f32, f32) {
-    if y < 0.0 || (y == 0.0 && x < 0.0) {
-        (-x, -y)
-    } else {
-        (x, y)
-    }
+    ((a * (BUCKETS as f32 / TURN)) as usize).min(BUCKETS - 1)
 }
 
 impl AngularIndex {
@@ -77,7 +74,7 @@ impl AngularIndex {
         // Bucket contents first (in entry j + 1), then the running union.
         for (k, s) in positions.iter().enumerate() {
             let d = *s - c;
-            let b = bucket(line_angle(d.dot(plane.u), d.dot(plane.v)));
+            let b = bucket(direction_angle(d.dot(plane.u), d.dot(plane.v)));
             self.prefix[(b + 1) * words + k / 64] |= 1 << (k % 64);
         }
         for j in 1..=BUCKETS {
@@ -91,52 +88,44 @@ impl AngularIndex {
     /// sample the exact test covers is among them); returns whether any is.
     pub fn candidates(&self, test: &EdgeTest, allowed: &[u64], out: &mut [u64]) -> bool {
         let (ga, gb) = test.sector_normals();
+        // In the light plane, the cone is A . d > 0 and B . d < 0 for d = s - c.
         let (ax, ay) = (ga.dot(self.u), ga.dot(self.v));
         let (bx, by) = (gb.dot(self.u), gb.dot(self.v));
         let all = |out: &mut [u64]| {
             out.copy_from_slice(allowed);
             allowed.iter().any(|w| *w != 0)
         };
-        // A sector plane (nearly) parallel to the light plane: leave it to the exact test.
+        // A sector plane (nearly) parallel to the light plane, or two (nearly) parallel lines
+        // (an uncertain orientation of the cone's sides): leave it to the exact test.
         let (la2, lb2) = (ax * ax + ay * ay, bx * bx + by * by);
         if !(la2 > 1e-8 * ga.length_squared() && lb2 > 1e-8 * gb.length_squared()) {
             return all(out);
         }
-        // Directions of the two boundary lines (perpendicular to the in-plane normals).
-        let (dax, day) = canonical(-ay, ax);
-        let (dbx, dby) = canonical(-by, bx);
-        let (ta, tb) = (line_angle(dax, day), line_angle(dbx, dby));
-        let (t1, t2) = (ta.min(tb), ta.max(tb));
-        // Between the two directions (the arc [t1, t2], where any positive combination of the
-        // two half-plane directions lies): do the two tests differ there? The lengths are
-        // balanced so that neither direction dominates, and nearly parallel or opposite
-        // directions (an uncertain sign) leave the choice to the exact test.
-        let (wa, wb) = (lb2.sqrt(), la2.sqrt());
-        let (mx, my) = (dax * wa + dbx * wb, day * wa + dby * wb);
-        let (sa, sb) = (ax * mx + ay * my, bx * mx + by * my);
-        let m2 = mx * mx + my * my;
-        if !(sa * sa > 1e-6 * la2 * m2 && sb * sb > 1e-6 * lb2 * m2) {
+        let cross = ax * by - ay * bx;
+        if !(cross * cross > 1e-6 * la2 * lb2) {
             return all(out);
         }
-        // The sector's interval, forward from `lo` to `hi` (circularly), widened.
-        let (lo, hi, len) = if (sa < 0.0) != (sb < 0.0) {
-            (t1 - MARGIN, t2 + MARGIN, t2 - t1 + 2.0 * MARGIN)
+        // The cone's sides: along A's line on the side where B . d < 0, along B's line on the
+        // side where A . d > 0; perp(A) = (-ay, ax) has B . perp(A) = cross and
+        // perp(B) = (-by, bx) has A . perp(B) = -cross.
+        let s = if cross > 0.0 { 1.0 } else { -1.0 };
+        let (dax, day) = (ay * s, -ax * s);
+        let (dbx, dby) = (by * s, -bx * s);
+        let (ta, tb) = (direction_angle(dax, day), direction_angle(dbx, dby));
+        // The cone is convex: its arc is the shorter one between its sides.
+        let ccw = (tb - ta).rem_euclid(TURN);
+        let (lo, len) = if ccw <= TURN / 2.0 {
+            (ta, ccw)
         } else {
-            (t2 - MARGIN, t1 + MARGIN, 2.0 - (t2 - t1) + 2.0 * MARGIN)
+            (tb, TURN - ccw)
         };
-        if len >= 2.0 - 2.0 / BUCKETS as f32 {
+        let (lo, len) = (lo - MARGIN, len + 2.0 * MARGIN);
+        if len >= TURN / 2.0 {
             return all(out);
         }
-        let wrap = |a: f32| {
-            if a < 0.0 {
-                a + 2.0
-            } else if a >= 2.0 {
-                a - 2.0
-            } else {
-                a
-            }
-        };
-        let (lo, hi) = (wrap(lo), wrap(hi));
+        let lo = if lo < 0.0 { lo + TURN } else { lo };
+        let hi = lo + len;
+        let hi = if hi >= TURN { hi - TURN } else { hi };
         let (bl, bh) = (bucket(lo), bucket(hi));
         let w = self.words;
         let (below_lo, upto_hi) = (
@@ -217,7 +206,7 @@ mod tests {
             total += 128;
         }
         assert!(covered > 1000, "{covered}");
-        // The double cone holds about twice the covered samples, far fewer than all.
-        assert!(candidates < total / 4, "{candidates} of {total}");
+        // The cone holds little more than the covered samples, far fewer than all.
+        assert!(candidates < total / 16, "{candidates} of {total}");
     }
 }

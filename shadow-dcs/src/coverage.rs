@@ -40,12 +40,42 @@ impl RelativeSamples {
     }
 }
 
+/// A planar light's convex polygon relative to a view sample `p`, with the largest L1 norm of
+/// its vertices (which bounds the Euclidean distances from above: a looser, cheaper slack for
+/// [`EdgeTest::may_cover`]).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct RelativePolygon {
+    points: Vec<Vec3>,
+    reach: f32,
+}
+
+impl RelativePolygon {
+    /// Sets the polygon `vertices - x`.
+    pub fn set(&mut self, vertices: &[Vec3], x: Vec3) {
+        self.points.clear();
+        self.points.extend(vertices.iter().map(|v| *v - x));
+        self.reach = self
+            .points
+            .iter()
+            .map(|v| v.abs().element_sum())
+            .fold(0.0f32, f32::max);
+    }
+}
+
 /// The four linear tests of one (view sample, edge) pair.
+///
+/// The samples an edge covers lie in one cone of the double cone between the planes
+/// `(p, c, a)` and `(p, c, b)`: where the edge crosses the triangle `(p, c, s)` at
+/// `x = a + t (b - a)`, `orient(p, c, s, a)` has the sign of `orient(p, c, x, a) =
+/// t det(a - p, c - p, b - p)` and `orient(p, c, s, b)` the opposite one (the sample lies on the
+/// ray from `c` through the projection of `x`). With `det(a - p, c - p, b - p) =
+/// -orient(a, b, p, c)`, `ga` and `gb` are oriented so that the covered cone is `ga . d > 0`,
+/// `gb . d < 0`.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct EdgeTest {
-    /// `orient(p, c, s, a) = ga . (s - p)`.
+    /// `+-orient(p, c, s, a) = ga . (s - p)`.
     ga: Vec3,
-    /// `orient(p, c, s, b) = gb . (s - p)`.
+    /// `+-orient(p, c, s, b) = gb . (s - p)` (the same sign as `ga`).
     gb: Vec3,
     /// `+-orient(a, b, c, s) = h1 . (s - p) + k1`, the sign chosen so that the line `a b`
     /// passes inside the triangle when this and the next are positive.
@@ -95,17 +125,18 @@ impl EdgeTest {
     ) -> Self {
         let sign = if positive { 1.0 } else { -1.0 };
         Self {
-            ga,
-            gb,
+            ga: ga * -sign,
+            gb: gb * -sign,
             h1: h1 * sign,
             k1: k1 * sign,
             h2: h2 * sign,
         }
     }
 
-    /// `orient(p, c, s, a)` and `orient(p, c, s, b)` as linear functions of `s - p`: their
+    /// `+-orient(p, c, s, a)` and `+-orient(p, c, s, b)` as linear functions of `s - p`: their
     /// zero sets are the planes through `p`, `c` and an end point, which bound the angular
-    /// sector (used by [`crate::angular`]).
+    /// sector (used by [`crate::angular`]); covered samples have the first positive and the
+    /// second negative.
     pub fn sector_normals(&self) -> (Vec3, Vec3) {
         (self.ga, self.gb)
     }
@@ -114,19 +145,18 @@ impl EdgeTest {
     /// given the light's convex polygon relative to `p` (counter-clockwise or clockwise):
     /// `false` proves that no light sample is covered, so the pair need not be kept.
     ///
-    /// The covered region is `sector & w1 > 0 & w2 > 0`, with `w2 < 0` at `c`. If a light
+    /// The covered region is `cone & w1 > 0 & w2 > 0`, with `w2 < 0` at `c`. If a light
     /// point `q` is covered, the segment from `c` to `q` stays in the light, in the open
     /// sector (a cone with apex `c`) and in `w1 > 0` (`w1(c) = 0`), and crosses `w2 = 0`: so
     /// the chord `w2 = 0` of the light polygon meets the sector and `w1 > 0`. The chord is
     /// found on the polygon's boundary and the three linear functions clipped along it, with
     /// a relative slack of `1e-5` so that only clear misses are rejected (ties are kept).
-    pub fn may_cover(&self, polygon: &[Vec3]) -> bool {
+    pub fn may_cover(&self, light: &RelativePolygon) -> bool {
+        let (polygon, reach) = (&light.points[..], light.reach);
         let n = polygon.len();
-        // L1 norms bound the Euclidean ones from above: a looser, cheaper slack.
-        let reach = polygon
-            .iter()
-            .map(|v| v.abs().element_sum())
-            .fold(0.0f32, f32::max);
+        if n == 0 {
+            return true;
+        }
         let tol = |g: Vec3| 1e-5 * g.abs().element_sum() * reach;
         let t2 = tol(self.h2);
         let mut ends = [Vec3::ZERO; 2];
@@ -164,12 +194,9 @@ impl EdgeTest {
         }
         let (tw, ta, tb) = (tol(self.h1), tol(self.ga), tol(self.gb));
         let whole = clip_unit((0.0, 1.0), w0 + tw, w1 + tw);
-        let cone = |sa: f32, sb: f32| {
-            let r = clip_unit(whole, sa * a0 + ta, sa * a1 + ta);
-            let r = clip_unit(r, sb * b0 + tb, sb * b1 + tb);
-            r.0 <= r.1
-        };
-        cone(1.0, -1.0) || cone(-1.0, 1.0)
+        let r = clip_unit(whole, a0 + ta, a1 + ta);
+        let r = clip_unit(r, tb - b0, tb - b1);
+        r.0 <= r.1
     }
 
     /// True when the edge crosses the triangle `(p, c, p + d)`, `d` a sample relative to `p`.
@@ -179,8 +206,7 @@ impl EdgeTest {
         let vb = self.gb.x * x + self.gb.y * y + self.gb.z * z;
         let w1 = self.h1.x * x + self.h1.y * y + self.h1.z * z + self.k1;
         let w2 = self.h2.x * x + self.h2.y * y + self.h2.z * z;
-        let sector = (va > 0.0) & (vb < 0.0) | (va < 0.0) & (vb > 0.0);
-        sector & (w1 > 0.0) & (w2 > 0.0)
+        (va > 0.0) & (vb < 0.0) & (w1 > 0.0) & (w2 > 0.0)
     }
 
     /// True when the edge crosses the triangle `(p, c, s)`.
@@ -329,7 +355,8 @@ mod light_overlap_tests {
             let Some(t) = EdgeTest::new(p, c, a, b) else {
                 continue;
             };
-            let polygon: Vec<Vec3> = corners.iter().map(|v| (*v - p).as_vec3()).collect();
+            let mut polygon = RelativePolygon::default();
+            polygon.set(&corners.map(|v| (v - p).as_vec3()), Vec3::ZERO);
             let n = 48;
             let covers = (0..n * n).any(|j| {
                 let s = c + DVec3::new(

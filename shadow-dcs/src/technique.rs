@@ -37,7 +37,7 @@ use crate::angular::AngularIndex;
 use crate::centred::CentredEdge;
 use crate::constant::{eye_constant, integration_constants};
 use crate::counters::{Packed, WIDTHS, width_for};
-use crate::coverage::{EdgeTest, RelativeSamples};
+use crate::coverage::{EdgeTest, RelativePolygon, RelativeSamples};
 use crate::discrete::{CoveredSamples, DiscreteTables};
 use crate::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
 use crate::lanes::BAND_ROWS;
@@ -130,7 +130,7 @@ struct Scratch {
     positions: Vec<Vec3>,
     relative: RelativeSamples,
     angular: AngularIndex,
-    polygon: Vec<Vec3>,
+    polygon: RelativePolygon,
     tests: Vec<(u32, i32, EdgeTest)>,
     above: Vec<u64>,
     mask: Vec<u64>,
@@ -414,9 +414,7 @@ impl Dcs {
         let c = p.shape.center.as_dvec3();
         scratch.tests.clear();
         if let Some(poly) = &p.polygon {
-            scratch.polygon.clear();
-            let x = f.centred[i];
-            scratch.polygon.extend(poly.iter().map(|v| *v - x));
+            scratch.polygon.set(poly, f.centred[i]);
         }
         let pc = o - c;
         for pair in entries {
