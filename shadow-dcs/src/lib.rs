@@ -15,6 +15,8 @@
 //!   edge's candidate samples with two lookups (section 7.3's sector table, per pixel);
 //! * `centred` (internal): the per-(pixel, edge) tests in light-centred single precision, with
 //!   exact fallbacks;
+//! * `lanes` (internal): tiles of 4 x 4 view samples in structure-of-arrays form, on which the
+//!   wedge scan tests a wedge's planes and weights for the whole tile at once;
 //! * [`discrete`]: the sector and line tables of section 7.3 (Fig. 8);
 //! * [`counters`]: packed counters with overflow detection (sections 4.3, 4.4, 5.3);
 //! * [`technique`]: the [`Dcs`] technique; [`presets`] registers its configurations.

@@ -278,7 +278,9 @@ pub(crate) fn region_rows(regions: &[Region]) -> Vec<(u32, u32)> {
 /// The pairs of rows `rows` (a band): every region overlapping the band is scanned there (its
 /// screen polygon's column range over the band's rows, tile by tile, skipping tiles whose view
 /// samples' box lies outside the wedge's planes or where the edge cannot be a silhouette), and
-/// each active pixel with a non-zero weight `k_e(p)` is kept.
+/// each active pixel with a non-zero weight `k_e(p)` is kept. A tile's planes and weights are
+/// evaluated on all its view samples at once ([`crate::lanes`]); lanes whose weight signs are
+/// uncertain take the exact `SceneEdge::sweep_weight`.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn band_pairs(
     edges: &[SceneEdge],
