@@ -113,7 +113,7 @@ impl AngularIndex {
         let (dbx, dby) = (by * s, -bx * s);
         let (ta, tb) = (direction_angle(dax, day), direction_angle(dbx, dby));
         // The cone is convex: its arc is the shorter one between its sides.
-        let ccw = (tb - ta).rem_euclid(TURN);
+        let ccw = if tb >= ta { tb - ta } else { tb - ta + TURN };
         let (lo, len) = if ccw <= TURN / 2.0 {
             (ta, ccw)
         } else {
