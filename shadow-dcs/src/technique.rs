@@ -786,6 +786,30 @@ impl ShadowTechnique for Dcs {
                         let x = i - first;
                         r.class[x] = class;
                         let vis = &scratch.vis;
+                        // Lit and umbra pixels (most of an image): every sample alike.
+                        let uniform = match class {
+                            PixelClass::Lit => Some(true),
+                            PixelClass::Umbra | PixelClass::Skipped => Some(false),
+                            _ => None,
+                        };
+                        if let (Some(lit), false, false) =
+                            (uniform, textured, output == PerSampleOutput::Counters)
+                        {
+                            r.v[x] = if lit { 1.0 } else { 0.0 };
+                            if lit && output == PerSampleOutput::Bits {
+                                for (k, word) in
+                                    r.bits[x * words..(x + 1) * words].iter_mut().enumerate()
+                                {
+                                    let left = n - k * 64;
+                                    *word = if left >= 64 {
+                                        u64::MAX
+                                    } else {
+                                        (1 << left) - 1
+                                    };
+                                }
+                            }
+                            return;
+                        }
                         let sum: f64 = vis.iter().map(|&v| v as f64).sum();
                         r.v[x] = (sum / n as f64) as f32;
                         if textured {
