@@ -417,14 +417,22 @@ impl Dcs {
             scratch.polygon.set(poly, f.centred[i]);
         }
         let pc = o - c;
+        // The light-overlap test decides whether the pixel needs per-sample work at all. With
+        // the angular index, once one pair may cover the light the later pairs go straight to
+        // their candidates, which drop off-light pairs at least as cheaply.
+        let indexed_mode = p.shape.plane.is_some() && self.covered == CoveredSamples::Exact;
+        let mut filter = p.polygon.is_some();
         for pair in entries {
             let Some(test) = p.centred_edges[pair.edge as usize].test(pc) else {
                 counts.ties += 1;
                 continue;
             };
-            if p.polygon.is_some() && !test.may_cover(&scratch.polygon) {
-                counts.off_light += 1;
-                continue;
+            if filter {
+                if !test.may_cover(&scratch.polygon) {
+                    counts.off_light += 1;
+                    continue;
+                }
+                filter = !indexed_mode;
             }
             scratch.tests.push((pair.edge, pair.k, test));
         }
