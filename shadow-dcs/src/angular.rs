@@ -39,21 +39,15 @@ pub(crate) struct AngularIndex {
 }
 
 /// The direction of `(x, y)` as a monotone pseudo-angle in `[0, 4)` (the "diamond angle": 0
-/// along +x, 1 along +y, 2 along -x, 3 along -y); 0 for the zero vector.
+/// along +x, 1 along +y, 2 along -x, 3 along -y); 0 for the zero vector. Branch-free: with
+/// `t = x / (|x| + |y|)` it is `1 - t` on the upper half-plane and `3 + t` on the lower one.
 #[inline]
 fn direction_angle(x: f32, y: f32) -> f32 {
     let r = x.abs() + y.abs();
-    if !(r > 0.0) {
-        return 0.0;
-    }
-    let a = if y >= 0.0 {
-        if x >= 0.0 { y / r } else { 1.0 - x / r }
-    } else if x < 0.0 {
-        2.0 - y / r
-    } else {
-        3.0 + x / r
-    };
-    if a < TURN { a.max(0.0) } else { 0.0 }
+    let t = x / r;
+    let a = if y >= 0.0 { 1.0 - t } else { 3.0 + t };
+    // Zero vector (NaN) and the rounding to 4 just below +x both map to 0.
+    if (0.0..TURN).contains(&a) { a } else { 0.0 }
 }
 
 /// The bucket of a pseudo-angle in `[0, 4)`.

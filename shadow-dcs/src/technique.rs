@@ -22,7 +22,7 @@
 //! off their surface, exactly as the reference does ([`shadow_core::offset`]), so that with the
 //! same samples the two agree sample by sample up to numerical ties.
 
-use glam::{Vec2, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 use rayon::prelude::*;
 use serde_json::json;
 use shadow_core::direct::pixel_direct;
@@ -131,7 +131,6 @@ struct Scratch {
     relative: RelativeSamples,
     angular: AngularIndex,
     polygon: RelativePolygon,
-    tests: Vec<(u32, i32, EdgeTest)>,
     above: Vec<u64>,
     mask: Vec<u64>,
     candidates: Vec<u64>,
@@ -409,34 +408,36 @@ impl Dcs {
         let d0 = d0 as u64;
         let units = p.units as f32;
         let textured = p.light.is_textured();
-        // Each pair's covered-sample test, kept when the edge may cover part of the light.
+        // Each pair's covered-sample test. The light-overlap test decides whether the pixel
+        // needs per-sample work at all: its samples are set up at the first pair that may cover
+        // the light (at once when the horizon cuts the light). With the angular index the later
+        // pairs go straight to their candidates, which drop off-light pairs more cheaply.
         let o = origin.as_dvec3();
-        let c = p.shape.center.as_dvec3();
-        scratch.tests.clear();
+        let pc = o - p.shape.center.as_dvec3();
         if let Some(poly) = &p.polygon {
             scratch.polygon.set(poly, f.centred[i]);
         }
-        let pc = o - c;
-        // The light-overlap test decides whether the pixel needs per-sample work at all. With
-        // the angular index, once one pair may cover the light the later pairs go straight to
-        // their candidates, which drop off-light pairs at least as cheaply.
-        let indexed_mode = p.shape.plane.is_some() && self.covered == CoveredSamples::Exact;
-        let mut filter = p.polygon.is_some();
+        let indexed = p.shape.plane.is_some() && self.covered == CoveredSamples::Exact;
+        let mut ready = horizon == Horizon::Mixed;
+        if ready {
+            self.sample_setup(p, s, origin, indexed, scratch);
+        }
         for pair in entries {
             let Some(test) = p.centred_edges[pair.edge as usize].test(pc) else {
                 counts.ties += 1;
                 continue;
             };
-            if filter {
-                if !test.may_cover(&scratch.polygon) {
-                    counts.off_light += 1;
-                    continue;
-                }
-                filter = !indexed_mode;
+            if (!ready || !indexed) && p.polygon.is_some() && !test.may_cover(&scratch.polygon) {
+                counts.off_light += 1;
+                continue;
             }
-            scratch.tests.push((pair.edge, pair.k, test));
+            if !ready {
+                self.sample_setup(p, s, origin, indexed, scratch);
+                ready = true;
+            }
+            self.covered_update(p, s, o, pair, &test, indexed, scratch, counts);
         }
-        if scratch.tests.is_empty() && horizon == Horizon::Above {
+        if !ready {
             // No wedge: every sample has the integration constant.
             counts.constant_only += 1;
             let v = 1.0 - (d0 as f32 / units).min(1.0);
@@ -458,74 +459,6 @@ impl Dcs {
             };
         }
         counts.per_sample += 1;
-        self.sampler.unit_samples(s.pixel, &mut scratch.units);
-        let light = p.light.as_ref();
-        scratch
-            .samples
-            .extend(scratch.units.iter().map(|u| light.sample(*u)));
-        scratch.positions.clear();
-        scratch
-            .positions
-            .extend(scratch.samples.iter().map(|l| l.position));
-        // Samples above the horizon (the reference's rule).
-        scratch.above.clear();
-        scratch.above.resize(words, 0);
-        let nrm = s.geometric_normal;
-        for (k, y) in scratch.positions.iter().enumerate() {
-            if (*y - s.position).dot(nrm) > 0.0 && (*y - origin).dot(nrm) > 0.0 {
-                scratch.above[k / 64] |= 1 << (k % 64);
-            }
-        }
-        // Covered samples of every wedge edge.
-        scratch.masks.clear();
-        scratch.weights.clear();
-        scratch.relative.set(origin, &scratch.positions);
-        let indexed = match (&p.shape.plane, self.covered) {
-            (Some(plane), CoveredSamples::Exact) => {
-                scratch
-                    .angular
-                    .build(plane, p.shape.center, &scratch.positions);
-                true
-            }
-            _ => false,
-        };
-        for v in [&mut scratch.mask, &mut scratch.candidates] {
-            v.clear();
-            v.resize(words, 0);
-        }
-        for (edge, k, test) in &scratch.tests {
-            counts.edge_tests += 1;
-            let (mask, cand) = (&mut scratch.mask, &mut scratch.candidates);
-            let any = match (&self.covered, &p.tables) {
-                (CoveredSamples::Discrete | CoveredSamples::Refined, Some(t)) => t.mask(
-                    s.pixel,
-                    test,
-                    o,
-                    &p.edges[*edge as usize],
-                    &scratch.relative,
-                    &scratch.above,
-                    mask,
-                ),
-                _ if indexed => {
-                    if !scratch.angular.candidates(test, &scratch.above, cand) {
-                        counts.sector_empty += 1;
-                        false
-                    } else if cand.iter().map(|w| w.count_ones()).sum::<u32>() <= FEW_CANDIDATES {
-                        mask.fill(0);
-                        test.add_covered(&scratch.relative, cand, mask);
-                        mask.iter().any(|w| *w != 0)
-                    } else {
-                        test.mask(&scratch.relative, cand, mask)
-                    }
-                }
-                _ => test.mask(&scratch.relative, &scratch.above, mask),
-            };
-            if any {
-                counts.covered_updates += 1;
-                scratch.masks.extend_from_slice(mask);
-                scratch.weights.push(*k as i64);
-            }
-        }
         // Packed counters, outer wedges (k > 0) before inner ones (section 4.4); wider lanes on
         // overflow, plain signed counters as the last resort.
         let mut done = false;
@@ -582,6 +515,97 @@ impl Dcs {
             PixelClass::Umbra
         } else {
             PixelClass::Penumbra
+        }
+    }
+
+    /// A per-sample pixel's samples: positions, the horizon mask, the samples relative to the
+    /// view sample, the angular index (`indexed`), and empty update lists.
+    fn sample_setup(
+        &self,
+        p: &Prepared,
+        s: &ViewSample,
+        origin: Vec3,
+        indexed: bool,
+        scratch: &mut Scratch,
+    ) {
+        let words = (self.sampler.count() as usize).div_ceil(64);
+        self.sampler.unit_samples(s.pixel, &mut scratch.units);
+        let light = p.light.as_ref();
+        scratch.samples.clear();
+        scratch
+            .samples
+            .extend(scratch.units.iter().map(|u| light.sample(*u)));
+        scratch.positions.clear();
+        scratch
+            .positions
+            .extend(scratch.samples.iter().map(|l| l.position));
+        // Samples above the horizon (the reference's rule).
+        scratch.above.clear();
+        scratch.above.resize(words, 0);
+        let nrm = s.geometric_normal;
+        for (k, y) in scratch.positions.iter().enumerate() {
+            if (*y - s.position).dot(nrm) > 0.0 && (*y - origin).dot(nrm) > 0.0 {
+                scratch.above[k / 64] |= 1 << (k % 64);
+            }
+        }
+        scratch.masks.clear();
+        scratch.weights.clear();
+        scratch.relative.set(origin, &scratch.positions);
+        if let (Some(plane), true) = (&p.shape.plane, indexed) {
+            scratch
+                .angular
+                .build(plane, p.shape.center, &scratch.positions);
+        }
+        for v in [&mut scratch.mask, &mut scratch.candidates] {
+            v.clear();
+            v.resize(words, 0);
+        }
+    }
+
+    /// The samples one pair's edge covers (section 7.3 tables, angular candidates and the exact
+    /// test, or the exact test alone), appended to the pixel's updates when there is any.
+    #[allow(clippy::too_many_arguments)]
+    fn covered_update(
+        &self,
+        p: &Prepared,
+        s: &ViewSample,
+        o: DVec3,
+        pair: &Pair,
+        test: &EdgeTest,
+        indexed: bool,
+        scratch: &mut Scratch,
+        counts: &mut Counts,
+    ) {
+        counts.edge_tests += 1;
+        let (mask, cand) = (&mut scratch.mask, &mut scratch.candidates);
+        let any = match (&self.covered, &p.tables) {
+            (CoveredSamples::Discrete | CoveredSamples::Refined, Some(t)) => t.mask(
+                s.pixel,
+                test,
+                o,
+                &p.edges[pair.edge as usize],
+                &scratch.relative,
+                &scratch.above,
+                mask,
+            ),
+            _ if indexed => {
+                if !scratch.angular.candidates(test, &scratch.above, cand) {
+                    counts.sector_empty += 1;
+                    false
+                } else if cand.iter().map(|w| w.count_ones()).sum::<u32>() <= FEW_CANDIDATES {
+                    mask.fill(0);
+                    test.add_covered(&scratch.relative, cand, mask);
+                    mask.iter().any(|w| *w != 0)
+                } else {
+                    test.mask(&scratch.relative, cand, mask)
+                }
+            }
+            _ => test.mask(&scratch.relative, &scratch.above, mask),
+        };
+        if any {
+            counts.covered_updates += 1;
+            scratch.masks.extend_from_slice(mask);
+            scratch.weights.push(pair.k as i64);
         }
     }
 
