@@ -348,7 +348,12 @@ pub(crate) fn band_pairs(
             let Some((lo, hi)) = tiles[tc as usize] else {
                 continue;
             };
-            if rejects(r, lo, hi) {
+            // The tile's box against the fold planes only: the wedge planes are cheaper on
+            // the lanes themselves.
+            if r.centred_fold
+                .as_ref()
+                .is_some_and(|f| !fold_possible_in(f, lo, hi, slack))
+            {
                 continue;
             }
             let tile = &lanes[tc as usize];
