@@ -14,9 +14,11 @@
 //!    illumination from the per-sample binary visibility (eq. 6).
 //!
 //! Work a view sample does not need is skipped and counted: a receiver facing away from the
-//! whole light is 0 without samples; one in no wedge takes its integration constant for every
-//! sample (fully lit or umbra, no counters); the texture and opacity paths run only when the
-//! light is textured or the scene semi-opaque.
+//! whole light is 0 without samples; one in no wedge, or whose wedge edges all miss the light
+//! (the exact light-overlap test, `wedge-pairs-off-light`), takes its integration constant for
+//! every sample (fully lit or umbra, no counters); a pair whose angular sector holds no sample
+//! is dropped without a per-sample test (`wedge-pairs-empty-sector`); the texture and opacity
+//! paths run only when the light is textured or the scene semi-opaque.
 //!
 //! Light samples behind the receiver's tangent plane are occluded, and view samples are offset
 //! off their surface, exactly as the reference does ([`shadow_core::offset`]), so that with the
