@@ -270,6 +270,33 @@ mod tests {
         }
     }
 
+    /// Case `k`: a light centre and below it an edge with two faces (their orientations
+    /// flipped by `flips`), everything moved by `offset` along the diagonal.
+    fn random_edge(
+        k: u64,
+        offset: f64,
+        flips: (bool, bool),
+        two_sided: bool,
+    ) -> (DVec3, SceneEdge) {
+        let r = |i: u64| unit_float(hash_words(&[k, i])) as f64 * 2.0 - 1.0;
+        let o = DVec3::splat(offset);
+        let c = o + DVec3::new(r(0), 3.0 + r(1), r(2));
+        let a = o + DVec3::new(r(3), 1.0 + r(4) * 0.5, r(5));
+        let b = a + DVec3::new(r(6), r(7), r(8)) * 0.3;
+        let t1 = a + DVec3::new(r(9), r(10), r(11)) * 0.3;
+        let t2 = a + DVec3::new(r(12), r(13), r(14)) * 0.3;
+        let edge = SceneEdge {
+            a,
+            b,
+            faces: vec![
+                face(a, b, t1, flips.0, two_sided),
+                face(b, a, t2, flips.1, two_sided),
+            ],
+            always: false,
+        };
+        (c, edge)
+    }
+
     /// On full tiles every lane with certain signs gets the exact weight, whatever its
     /// neighbours, and almost every lane is certain.
     #[test]
@@ -277,20 +304,7 @@ mod tests {
         let (mut certain, mut total) = (0, 0);
         for k in 0..400u64 {
             let r = |i: u64| unit_float(hash_words(&[k, i])) as f64 * 2.0 - 1.0;
-            let c = DVec3::new(r(0), 3.0 + r(1), r(2));
-            let a = DVec3::new(r(3), 1.0 + r(4) * 0.5, r(5));
-            let b = a + DVec3::new(r(6), r(7), r(8)) * 0.3;
-            let t1 = a + DVec3::new(r(9), r(10), r(11)) * 0.3;
-            let t2 = a + DVec3::new(r(12), r(13), r(14)) * 0.3;
-            let edge = SceneEdge {
-                a,
-                b,
-                faces: vec![
-                    face(a, b, t1, k % 2 == 0, k % 3 == 0),
-                    face(b, a, t2, k % 4 < 2, k % 3 == 0),
-                ],
-                always: false,
-            };
+            let (c, edge) = random_edge(k, 0.0, (k % 2 == 0, k % 4 < 2), k % 3 == 0);
             let points: Vec<DVec3> = (0..LANES as u64)
                 .map(|j| {
                     DVec3::new(
@@ -329,20 +343,8 @@ mod tests {
         for (k, offset) in (0..3000u64).zip([0.0, 1e3, 1e5].into_iter().cycle()) {
             let r = |i: u64| unit_float(hash_words(&[k, i])) as f64 * 2.0 - 1.0;
             let o = DVec3::splat(offset);
-            let c = o + DVec3::new(r(0), 3.0 + r(1), r(2));
-            let a = o + DVec3::new(r(3), 1.0 + r(4) * 0.5, r(5));
-            let b = a + DVec3::new(r(6), r(7), r(8)) * 0.3;
-            let t1 = a + DVec3::new(r(9), r(10), r(11)) * 0.3;
-            let t2 = a + DVec3::new(r(12), r(13), r(14)) * 0.3;
-            let edge = SceneEdge {
-                a,
-                b,
-                faces: vec![
-                    face(a, b, t1, k % 2 == 0, k % 5 == 0),
-                    face(b, a, t2, k % 3 == 0, k % 5 == 0),
-                ],
-                always: false,
-            };
+            let (c, edge) = random_edge(k, offset, (k % 2 == 0, k % 3 == 0), k % 5 == 0);
+            let (a, b) = (edge.a, edge.b);
             let p = o + DVec3::new(r(15) * 2.0, r(16) * 0.2, r(17) * 2.0);
             let pc = (p - c).as_vec3();
             let fast = FastWeight::new(&edge, c).unwrap();
