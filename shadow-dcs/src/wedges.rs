@@ -276,8 +276,9 @@ pub(crate) fn region_rows(regions: &[Region]) -> Vec<(u32, u32)> {
 }
 
 /// The pairs of rows `rows` (a band): every region overlapping the band is scanned there (its
-/// screen polygon's column range over the band's rows, tile by tile, skipping tiles whose view
-/// samples' box lies outside the wedge's planes or where the edge cannot be a silhouette), and
+/// screen polygon's column range over the band's rows, tile by tile, skipping groups of tiles
+/// whose view samples' box lies outside the wedge's planes or where the edge cannot be a
+/// silhouette, and tiles where it cannot be one), and
 /// each active pixel with a non-zero weight `k_e(p)` is kept. A tile's planes and weights are
 /// evaluated on all its view samples at once ([`crate::lanes`]); lanes whose weight signs are
 /// uncertain take the exact `SceneEdge::sweep_weight`.
@@ -312,11 +313,13 @@ pub(crate) fn band_pairs(
             scanned: 0,
         };
     };
+    let no_silhouette = |r: &Region, lo: Vec3, hi: Vec3| -> bool {
+        r.centred_fold
+            .as_ref()
+            .is_some_and(|f| !fold_possible_in(f, lo, hi, slack))
+    };
     let rejects = |r: &Region, lo: Vec3, hi: Vec3| -> bool {
-        r.centred_planes.iter().any(|p| p.max_over(lo, hi) < 0.0)
-            || r.centred_fold
-                .as_ref()
-                .is_some_and(|f| !fold_possible_in(f, lo, hi, slack))
+        r.centred_planes.iter().any(|p| p.max_over(lo, hi) < 0.0) || no_silhouette(r, lo, hi)
     };
     for (ri, _) in all_rows
         .iter()
@@ -350,10 +353,7 @@ pub(crate) fn band_pairs(
             };
             // The tile's box against the fold planes only: the wedge planes are cheaper on
             // the lanes themselves.
-            if r.centred_fold
-                .as_ref()
-                .is_some_and(|f| !fold_possible_in(f, lo, hi, slack))
-            {
+            if no_silhouette(r, lo, hi) {
                 continue;
             }
             let tile = &lanes[tc as usize];
