@@ -130,13 +130,22 @@ fn gpu_stages_equal_their_cpu_computation() {
                     Influence::Culled => assert!(reg.bbox[2] < reg.bbox[0], "{name} tri {t}"),
                     Influence::WholeMap => assert_eq!(reg.info[1], 1, "{name} tri {t}"),
                     Influence::Hull(h) if h.len() >= 3 && reg.info[1] == 0 => {
-                        assert_eq!(reg.info[0] as usize, h.len(), "{name} tri {t}");
-                        for (a, b) in h.iter().zip(&reg.pts) {
-                            assert!(
-                                (*a - glam::Vec2::from(*b)).abs().max_element()
-                                    < 1e-3 * (1.0 + a.abs().max_element()),
-                                "{name} tri {t}"
-                            );
+                        // The same polygon, compared geometrically: a vertex that is
+                        // collinear up to rounding may be kept on one side and dropped on the
+                        // other (an NVIDIA driver's fused multiply-adds drop some that the CPU
+                        // keeps), which moves no edge by more than rounding.
+                        let gpu: Vec<glam::Vec2> = reg.pts[..reg.info[0] as usize]
+                            .iter()
+                            .map(|p| glam::Vec2::from(*p))
+                            .collect();
+                        assert!(gpu.len() >= 3, "{name} tri {t}: {} GPU vertices", gpu.len());
+                        for (from, to) in [(&h, &gpu), (&gpu, &h)] {
+                            for p in from.iter() {
+                                assert!(
+                                    inside_convex(to, *p, 1e-3 * (1.0 + p.abs().max_element())),
+                                    "{name} tri {t}: CPU hull {h:?}, GPU hull {gpu:?}"
+                                );
+                            }
                         }
                     }
                     Influence::Hull(_) => {}
@@ -191,4 +200,13 @@ fn hard_shadows_agree_with_the_reference_hard_shadow() {
         println!("{name:<22} hard-shadow pixel agreement {share:.6}");
         assert!(share >= 0.999, "{name}: {share}");
     }
+}
+
+/// Whether `p` lies in the counter-clockwise convex polygon `poly` grown by `tol`.
+fn inside_convex(poly: &[glam::Vec2], p: glam::Vec2, tol: f32) -> bool {
+    (0..poly.len()).all(|k| {
+        let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+        let e = b - a;
+        e.perp_dot(p - a) >= -tol * e.length()
+    })
 }
