@@ -135,15 +135,20 @@ impl LightSampler {
 
     /// Appends the jittered set of `base` (a hash of the set's key) to `out`.
     fn jittered_into(&self, base: u64, out: &mut Vec<Vec2>) {
-        for k in 0..self.count {
-            let (cx, cy) = (k % self.grid.x, k / self.grid.x);
-            let h = mix64(base ^ mix64(k as u64 ^ 0x6a09_e667_f3bc_c909));
-            let jx = unit_float(h);
-            let jy = unit_float(mix64(h));
-            out.push(Vec2::new(
-                ((cx as f32 + jx) / self.grid.x as f32).min(ONE_MINUS),
-                ((cy as f32 + jy) / self.grid.y as f32).min(ONE_MINUS),
-            ));
+        // Row by row: sample `k` is cell `(k % grid.x, k / grid.x)`, without a division each.
+        let (gx, gy) = (self.grid.x as f32, self.grid.y as f32);
+        let mut k = 0u64;
+        for cy in 0..self.grid.y {
+            for cx in 0..self.grid.x {
+                let h = mix64(base ^ mix64(k ^ 0x6a09_e667_f3bc_c909));
+                let jx = unit_float(h);
+                let jy = unit_float(mix64(h));
+                out.push(Vec2::new(
+                    ((cx as f32 + jx) / gx).min(ONE_MINUS),
+                    ((cy as f32 + jy) / gy).min(ONE_MINUS),
+                ));
+                k += 1;
+            }
         }
     }
 

@@ -20,7 +20,7 @@
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use shadow_core::raster::{Projection, RasterView, for_each_covered_pixel};
+use shadow_core::raster::{CoveredPixels, Projection, RasterView};
 use shadow_core::scene::Scene;
 
 use crate::edges::{SceneEdge, ray_hits_triangle};
@@ -29,6 +29,9 @@ use crate::edges::{SceneEdge, ray_hits_triangle};
 /// far edge is a chord, and it stays beyond every view sample unless the edge subtends more
 /// than 178 degrees from the light centre (an occluder touching the centre).
 const FAR_FACTOR: f64 = 64.0;
+
+/// Rows per band of the parallel quad rasterization.
+const SV_BAND: u32 = 8;
 
 /// `D(eye, c)`: the weighted crossings of the segment from the eye to the light centre, with the
 /// faces counted from the light's side (front faces of one-sided meshes, every face of
@@ -39,25 +42,25 @@ pub(crate) fn eye_constant(scene: &dyn Scene, edges_units: u32, eye: Vec3, c: Ve
     let topo = scene.topology();
     let opac = scene.opacities();
     let semi = scene.has_semi_opaque();
-    let mut total = 0i64;
-    for t in 0..scene.triangle_count() {
-        let [a, b, cc] = scene.triangle(t).map(|v| v.as_dvec3());
-        if !ray_hits_triangle(o, d, a, b, cc, 1.0) {
-            continue;
-        }
-        let comp = &topo.components()[topo.component_of(t)];
-        let one_sided = comp.closed && comp.consistently_oriented;
-        let front_from_light = (b - a).cross(cc - a).dot(target - a) > 0.0;
-        if one_sided && !front_from_light {
-            continue;
-        }
-        total += if semi {
-            (opac[t].clamp(0.0, 1.0) * edges_units as f32).ceil() as i64
-        } else {
-            1
-        };
-    }
-    total
+    (0..scene.triangle_count())
+        .into_par_iter()
+        .map(|t| {
+            let [a, b, cc] = scene.triangle(t).map(|v| v.as_dvec3());
+            if !ray_hits_triangle(o, d, a, b, cc, 1.0) {
+                return 0;
+            }
+            let comp = &topo.components()[topo.component_of(t)];
+            let one_sided = comp.closed && comp.consistently_oriented;
+            let front_from_light = (b - a).cross(cc - a).dot(target - a) > 0.0;
+            if one_sided && !front_from_light {
+                0
+            } else if semi {
+                (opac[t].clamp(0.0, 1.0) * edges_units as f32).ceil() as i64
+            } else {
+                1
+            }
+        })
+        .sum()
 }
 
 /// The integration constant of every pixel (0 for background), by rasterizing the
@@ -103,7 +106,7 @@ pub(crate) fn integration_constants(
     };
     type Quad = (Vec<Vec3>, i64, DVec3, bool);
     let quads: Vec<Quad> = silhouettes
-        .iter()
+        .par_iter()
         .filter_map(|&i| {
             let e = &edges[i as usize];
             let k = e.sweep_weight(cd, eyed, true)?;
@@ -131,41 +134,53 @@ pub(crate) fn integration_constants(
     let near_view = near_zero(view, far_radius);
     let w = view.width as usize;
     let n = origins.len();
-    // A few large chunks: each holds one accumulator image.
-    let chunk = quads
-        .len()
-        .div_ceil(2 * rayon::current_num_threads())
-        .max(1);
-    let sums = quads
-        .par_chunks(chunk)
-        .map(|quads| {
-            let mut acc = vec![0i64; n];
-            for (q, k, normal, eye_positive) in quads {
-                let mut visit = |x: u32, y: u32| {
+    // Each quad's fan of screen triangles, set up once, then binned by bands of rows: every
+    // band sums its own rows, so no image-sized accumulator is merged.
+    let triangles: Vec<(CoveredPixels, u32)> = quads
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(qi, (q, ..))| {
+            (1..q.len() - 1).map(move |j| {
+                (
+                    CoveredPixels::new(&near_view, [q[0], q[j], q[j + 1]]),
+                    qi as u32,
+                )
+            })
+        })
+        .collect();
+    let bands = view.height.div_ceil(SV_BAND) as usize;
+    let mut bins: Vec<Vec<u32>> = vec![Vec::new(); bands];
+    for (t, (tri, _)) in triangles.iter().enumerate() {
+        if let Some((y0, y1)) = tri.rows() {
+            let last = ((y1 / SV_BAND) as usize).min(bands.saturating_sub(1));
+            for bin in &mut bins[(y0 / SV_BAND) as usize..=last] {
+                bin.push(t as u32);
+            }
+        }
+    }
+    let mut sums = vec![0i64; n];
+    sums.par_chunks_mut(SV_BAND as usize * w)
+        .zip(&bins)
+        .enumerate()
+        .for_each(|(band, (acc, bin))| {
+            let y0 = band as u32 * SV_BAND;
+            let y1 = y0 + SV_BAND - 1;
+            let first = y0 as usize * w;
+            for &t in bin {
+                let (tri, qi) = &triangles[t as usize];
+                let (_, k, normal, eye_positive) = &quads[*qi as usize];
+                tri.for_each_in_rows(y0, y1, |x, y| {
                     let i = y as usize * w + x as usize;
                     if !valid[i] {
                         return;
                     }
                     let side = normal.dot(origins[i].as_dvec3() - cd);
                     if side != 0.0 && (side > 0.0) != *eye_positive {
-                        acc[i] += k;
+                        acc[i - first] += k;
                     }
-                };
-                for j in 1..q.len() - 1 {
-                    for_each_covered_pixel(&near_view, [q[0], q[j], q[j + 1]], &mut visit);
-                }
+                });
             }
-            acc
-        })
-        .reduce(
-            || vec![0i64; n],
-            |mut a, b| {
-                for (x, y) in a.iter_mut().zip(b) {
-                    *x += y;
-                }
-                a
-            },
-        );
+        });
     let out = sums
         .into_iter()
         .zip(valid)

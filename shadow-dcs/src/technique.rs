@@ -378,7 +378,7 @@ impl Dcs {
     }
 
     /// Per-sample visibility of pixel `i` into `scratch.vis` (and depth complexities into
-    /// `scratch.depth`), samples in `scratch.samples`. Returns the class.
+    /// `scratch.depth`), the light samples in `scratch.samples` when the light is textured (their radiances weigh eq. 2). Returns the class.
     fn pixel(
         &self,
         p: &Prepared,
@@ -534,13 +534,20 @@ impl Dcs {
         self.sampler.unit_samples(s.pixel, &mut scratch.units);
         let light = p.light.as_ref();
         scratch.samples.clear();
-        scratch
-            .samples
-            .extend(scratch.units.iter().map(|u| light.sample(*u)));
         scratch.positions.clear();
-        scratch
-            .positions
-            .extend(scratch.samples.iter().map(|l| l.position));
+        if light.is_textured() {
+            // The radiances weigh the visibilities (eq. 2).
+            scratch
+                .samples
+                .extend(scratch.units.iter().map(|u| light.sample(*u)));
+            scratch
+                .positions
+                .extend(scratch.samples.iter().map(|l| l.position));
+        } else {
+            scratch
+                .positions
+                .extend(scratch.units.iter().map(|u| light.point_at(*u).0));
+        }
         // Samples above the horizon (the reference's rule).
         scratch.above.clear();
         scratch.above.resize(words, 0);

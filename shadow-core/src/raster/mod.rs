@@ -169,16 +169,45 @@ impl RasterView {
 /// shared by two triangles is reported for exactly one of them, whatever their winding. Used by
 /// techniques that rasterize volumes into the camera image (DCS's shadow-volume quads, section
 /// 4.1, and its wedges, section 4.2).
-pub fn for_each_covered_pixel(view: &RasterView, tri: [Vec3; 3], mut f: impl FnMut(u32, u32)) {
-    let v = tri.map(|p| view.view_from_world.transform_point3(p));
-    for st in setup_triangle(v, view) {
-        for y in st.ymin..=st.ymax {
-            let Some((x0, x1)) = st.row_candidates(y) else {
-                continue;
-            };
-            for x in x0..=x1 {
-                if st.covers(x, y) {
-                    f(x, y);
+pub fn for_each_covered_pixel(view: &RasterView, tri: [Vec3; 3], f: impl FnMut(u32, u32)) {
+    CoveredPixels::new(view, tri).for_each_in_rows(0, u32::MAX, f);
+}
+
+/// A world-space triangle set up once for [`for_each_covered_pixel`]'s coverage (near-plane
+/// clipping, top-left rule), so that a caller can visit its pixels one band of rows at a time:
+/// bands of an image then accumulate in parallel, each into its own rows.
+#[derive(Debug, Clone)]
+pub struct CoveredPixels {
+    parts: Vec<ScreenTriangle>,
+}
+
+impl CoveredPixels {
+    /// Sets up `tri` in `view`.
+    pub fn new(view: &RasterView, tri: [Vec3; 3]) -> Self {
+        let v = tri.map(|p| view.view_from_world.transform_point3(p));
+        Self {
+            parts: setup_triangle(v, view),
+        }
+    }
+
+    /// The first and last rows that may hold covered pixels; `None` when none can.
+    pub fn rows(&self) -> Option<(u32, u32)> {
+        let lo = self.parts.iter().map(|s| s.ymin).min()?;
+        let hi = self.parts.iter().map(|s| s.ymax).max()?;
+        Some((lo, hi))
+    }
+
+    /// Calls `f(x, y)` for every covered pixel in rows `y0..=y1`.
+    pub fn for_each_in_rows(&self, y0: u32, y1: u32, mut f: impl FnMut(u32, u32)) {
+        for st in &self.parts {
+            for y in st.ymin.max(y0)..=st.ymax.min(y1) {
+                let Some((x0, x1)) = st.row_candidates(y) else {
+                    continue;
+                };
+                for x in x0..=x1 {
+                    if st.covers(x, y) {
+                        f(x, y);
+                    }
                 }
             }
         }
@@ -344,5 +373,62 @@ mod tests {
             rasterize(&[], &[], &v, 1),
             Err(RasterError::Projection(_))
         ));
+    }
+
+    /// Visiting a triangle band by band reports the same pixels, once each, as one visit of
+    /// the whole image, a triangle clipped by the near plane included.
+    #[test]
+    fn covered_pixels_by_bands_equal_the_whole_visit() {
+        let view = RasterView {
+            width: 37,
+            height: 29,
+            view_from_world: Affine3A::IDENTITY,
+            projection: Projection::Perspective {
+                left: -1.0,
+                right: 1.0,
+                bottom: -0.8,
+                top: 0.8,
+                near: 0.1,
+            },
+        };
+        let triangles = [
+            [
+                Vec3::new(-3.0, -2.0, -4.0),
+                Vec3::new(2.5, -1.0, -3.0),
+                Vec3::new(0.2, 3.0, -5.0),
+            ],
+            // Crosses the near plane.
+            [
+                Vec3::new(-0.5, -0.5, 1.0),
+                Vec3::new(0.7, -0.2, -2.0),
+                Vec3::new(0.1, 0.9, -2.5),
+            ],
+            // A sliver.
+            [
+                Vec3::new(-2.0, -1.0, -3.0),
+                Vec3::new(2.0, 1.0, -3.0),
+                Vec3::new(2.0, 1.01, -3.0),
+            ],
+        ];
+        for tri in triangles {
+            let mut whole = Vec::new();
+            for_each_covered_pixel(&view, tri, |x, y| whole.push((x, y)));
+            let cover = CoveredPixels::new(&view, tri);
+            let (lo, hi) = cover.rows().expect("the triangle covers rows");
+            let mut banded = Vec::new();
+            for y0 in (0..view.height).step_by(4) {
+                cover.for_each_in_rows(y0, y0 + 3, |x, y| {
+                    assert!((y0..y0 + 4).contains(&y) && (lo..=hi).contains(&y));
+                    banded.push((x, y));
+                });
+            }
+            assert!(!whole.is_empty());
+            whole.sort_unstable();
+            banded.sort_unstable();
+            let n = banded.len();
+            banded.dedup();
+            assert_eq!(n, banded.len(), "a pixel reported twice");
+            assert_eq!(whole, banded);
+        }
     }
 }
