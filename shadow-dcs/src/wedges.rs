@@ -518,9 +518,11 @@ fn screen_region(
     // Clip the point cloud's hull against depth >= near: points in front, plus the crossings
     // of every segment from a point in front to a point behind.
     let depth = |q: &DVec3| -q.z;
-    let mut kept: Vec<DVec3> = vp.iter().copied().filter(|q| depth(q) >= near).collect();
-    let behind: Vec<DVec3> = vp.iter().copied().filter(|q| depth(q) < near).collect();
-    if !behind.is_empty() {
+    let kept: Vec<DVec3> = if vp.iter().all(|q| depth(q) >= near) {
+        vp
+    } else {
+        let mut kept: Vec<DVec3> = vp.iter().copied().filter(|q| depth(q) >= near).collect();
+        let behind: Vec<DVec3> = vp.iter().copied().filter(|q| depth(q) < near).collect();
         let front = kept.clone();
         for f in &front {
             for bq in &behind {
@@ -531,7 +533,8 @@ fn screen_region(
                 kept.push(q);
             }
         }
-    }
+        kept
+    };
     if kept.is_empty() {
         return Some(Vec::new());
     }
@@ -571,13 +574,21 @@ fn clip_hull_to_box(pts: Vec<DVec3>, dir: DVec3, lo: DVec3, hi: DVec3) -> Vec<DV
             p[axis] >= bound
         }
     };
-    let (ins, outs): (Vec<DVec3>, Vec<DVec3>) = pts.iter().partition(|p| inside(p));
-    if outs.is_empty() {
-        return ins;
+    let split = {
+        let mut pts = pts;
+        // Inside points first, in their order; the rest after them.
+        pts.sort_by_key(|p| !inside(p));
+        pts
+    };
+    let n_in = split.iter().take_while(|p| inside(p)).count();
+    if n_in == split.len() {
+        return split;
     }
-    let mut next = ins.clone();
-    for a in &ins {
-        for b in &outs {
+    let (ins, outs) = split.split_at(n_in);
+    let mut next = Vec::with_capacity(n_in * (1 + outs.len()));
+    next.extend_from_slice(ins);
+    for a in ins {
+        for b in outs {
             let t = (bound - a[axis]) / (b[axis] - a[axis]);
             let mut x = *a + (*b - *a) * t;
             x[axis] = bound;
@@ -597,23 +608,23 @@ pub(crate) fn convex_hull(mut p: Vec<DVec2>) -> Vec<DVec2> {
     }
     let cross = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
     let mut hull: Vec<DVec2> = Vec::with_capacity(p.len() * 2);
-    for pass in 0..2 {
-        let start = hull.len();
-        let it: Box<dyn Iterator<Item = &DVec2>> = if pass == 0 {
-            Box::new(p.iter())
-        } else {
-            Box::new(p.iter().rev())
-        };
-        for &q in it {
-            while hull.len() >= start + 2
-                && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0
-            {
-                hull.pop();
-            }
-            hull.push(q);
+    // Lower chain left to right, then upper chain right to left.
+    let chain = |hull: &mut Vec<DVec2>, q: DVec2, start: usize| {
+        while hull.len() >= start + 2 && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0
+        {
+            hull.pop();
         }
-        hull.pop();
+        hull.push(q);
+    };
+    for &q in &p {
+        chain(&mut hull, q, 0);
     }
+    hull.pop();
+    let start = hull.len();
+    for &q in p.iter().rev() {
+        chain(&mut hull, q, start);
+    }
+    hull.pop();
     hull
 }
 
