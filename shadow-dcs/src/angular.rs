@@ -53,7 +53,8 @@ fn direction_angle(x: f32, y: f32) -> f32 {
 /// The bucket of a pseudo-angle in `[0, 4)`.
 #[inline]
 fn bucket(a: f32) -> usize {
-    ((a * (BUCKETS as f32 / TURN)) as usize).min(BUCKETS - 1)
+    // Through `i32`, which vectorises; NaN and negative values give 0 as through `usize`.
+    ((a * (BUCKETS as f32 / TURN)) as i32).clamp(0, BUCKETS as i32 - 1) as usize
 }
 
 impl AngularIndex {
@@ -79,48 +80,45 @@ impl AngularIndex {
     }
 
     /// Writes to `out` the samples of `allowed` that may lie in the sector of `test` (every
-    /// sample the exact test covers is among them); returns whether any is.
+    /// sample the exact test covers is among them); returns whether any is. (The technique
+    /// takes its tests a batch at a time, [`AngularIndex::candidates_batch`].)
+    #[cfg(test)]
     pub fn candidates(&self, test: &EdgeTest, allowed: &[u64], out: &mut [u64]) -> bool {
         let (ga, gb) = test.sector_normals();
-        // In the light plane, the cone is A . d > 0 and B . d < 0 for d = s - c.
-        let (ax, ay) = (ga.dot(self.u), ga.dot(self.v));
-        let (bx, by) = (gb.dot(self.u), gb.dot(self.v));
-        let all = |out: &mut [u64]| {
+        let n = Normals::from([(ga, gb)].as_slice());
+        self.apply(n.sectors(self.u, self.v)[0], allowed, out)
+    }
+
+    /// [`AngularIndex::candidates`] of up to [`BATCH`] tests at once, `tests.len() * words`
+    /// words into `out`: the sectors' bucket ranges are computed lane by lane over the batch
+    /// (the same operations in the same order, so the same ranges), which the compiler turns
+    /// into vector instructions. Returns the mask of tests with any candidate.
+    pub fn candidates_batch(&self, tests: &[EdgeTest], allowed: &[u64], out: &mut [u64]) -> u32 {
+        debug_assert!(tests.len() <= BATCH);
+        let mut normals = [(Vec3::ZERO, Vec3::ZERO); BATCH];
+        for (n, t) in normals.iter_mut().zip(tests) {
+            *n = t.sector_normals();
+        }
+        let sectors = Normals::from(normals.as_slice()).sectors(self.u, self.v);
+        let w = self.words;
+        let mut any = 0u32;
+        for (i, s) in sectors.iter().take(tests.len()).enumerate() {
+            if self.apply(*s, allowed, &mut out[i * w..(i + 1) * w]) {
+                any |= 1 << i;
+            }
+        }
+        any
+    }
+
+    /// The samples of `allowed` in the buckets of `s` (all of `allowed` when the index cannot
+    /// narrow the sector).
+    #[inline]
+    fn apply(&self, s: Sector, allowed: &[u64], out: &mut [u64]) -> bool {
+        if !s.narrow {
             out.copy_from_slice(allowed);
-            allowed.iter().any(|w| *w != 0)
-        };
-        // A sector plane (nearly) parallel to the light plane, or two (nearly) parallel lines
-        // (an uncertain orientation of the cone's sides): leave it to the exact test.
-        let (la2, lb2) = (ax * ax + ay * ay, bx * bx + by * by);
-        if !(la2 > 1e-8 * ga.length_squared() && lb2 > 1e-8 * gb.length_squared()) {
-            return all(out);
+            return allowed.iter().any(|w| *w != 0);
         }
-        let cross = ax * by - ay * bx;
-        if !(cross * cross > 1e-6 * la2 * lb2) {
-            return all(out);
-        }
-        // The cone's sides: along A's line on the side where B . d < 0, along B's line on the
-        // side where A . d > 0; perp(A) = (-ay, ax) has B . perp(A) = cross and
-        // perp(B) = (-by, bx) has A . perp(B) = -cross.
-        let s = if cross > 0.0 { 1.0 } else { -1.0 };
-        let (dax, day) = (ay * s, -ax * s);
-        let (dbx, dby) = (by * s, -bx * s);
-        let (ta, tb) = (direction_angle(dax, day), direction_angle(dbx, dby));
-        // The cone is convex: its arc is the shorter one between its sides.
-        let ccw = if tb >= ta { tb - ta } else { tb - ta + TURN };
-        let (lo, len) = if ccw <= TURN / 2.0 {
-            (ta, ccw)
-        } else {
-            (tb, TURN - ccw)
-        };
-        let (lo, len) = (lo - MARGIN, len + 2.0 * MARGIN);
-        if len >= TURN / 2.0 {
-            return all(out);
-        }
-        let lo = if lo < 0.0 { lo + TURN } else { lo };
-        let hi = lo + len;
-        let hi = if hi >= TURN { hi - TURN } else { hi };
-        let (bl, bh) = (bucket(lo), bucket(hi));
+        let (bl, bh) = (s.lo as usize, s.hi as usize);
         let w = self.words;
         let (below_lo, upto_hi) = (
             &self.prefix[bl * w..bl * w + w],
@@ -128,15 +126,107 @@ impl AngularIndex {
         );
         let mut any = 0u64;
         for j in 0..w {
-            let range = if lo <= hi {
-                upto_hi[j] & !below_lo[j]
-            } else {
+            let range = if s.wraps {
                 upto_hi[j] | !below_lo[j]
+            } else {
+                upto_hi[j] & !below_lo[j]
             };
             out[j] = range & allowed[j];
             any |= out[j];
         }
         any != 0
+    }
+}
+
+/// Tests per [`AngularIndex::candidates_batch`].
+pub(crate) const BATCH: usize = 8;
+
+/// A sector as a range of buckets.
+#[derive(Debug, Clone, Copy, Default)]
+struct Sector {
+    /// False when the index cannot narrow the sector (every sample is a candidate).
+    narrow: bool,
+    /// The range runs from `lo` past the last bucket round to `hi`.
+    wraps: bool,
+    lo: u32,
+    hi: u32,
+}
+
+/// The sector normals of a batch of tests, structure of arrays.
+struct Normals {
+    a: [[f32; BATCH]; 3],
+    b: [[f32; BATCH]; 3],
+}
+
+impl From<&[(Vec3, Vec3)]> for Normals {
+    fn from(g: &[(Vec3, Vec3)]) -> Self {
+        let mut n = Normals {
+            a: [[0.0; BATCH]; 3],
+            b: [[0.0; BATCH]; 3],
+        };
+        for (i, (ga, gb)) in g.iter().enumerate().take(BATCH) {
+            for k in 0..3 {
+                n.a[k][i] = ga[k];
+                n.b[k][i] = gb[k];
+            }
+        }
+        n
+    }
+}
+
+impl Normals {
+    /// The bucket ranges of the batch's sectors, each step lane by lane over the batch (loops
+    /// the compiler vectorises), branch-free.
+    fn sectors(&self, u: Vec3, v: Vec3) -> [Sector; BATCH] {
+        type Lanes = [f32; BATCH];
+        let lanes = |f: &dyn Fn(usize) -> f32| -> Lanes { std::array::from_fn(f) };
+        let dot =
+            |g: &[Lanes; 3], w: Vec3| lanes(&|i| g[0][i] * w.x + g[1][i] * w.y + g[2][i] * w.z);
+        let len2 =
+            |g: &[Lanes; 3]| lanes(&|i| g[0][i] * g[0][i] + g[1][i] * g[1][i] + g[2][i] * g[2][i]);
+        // In the light plane, the cone is A . d > 0 and B . d < 0 for d = s - c.
+        let (ax, ay) = (dot(&self.a, u), dot(&self.a, v));
+        let (bx, by) = (dot(&self.b, u), dot(&self.b, v));
+        let (ga2, gb2) = (len2(&self.a), len2(&self.b));
+        let la2 = lanes(&|i| ax[i] * ax[i] + ay[i] * ay[i]);
+        let lb2 = lanes(&|i| bx[i] * bx[i] + by[i] * by[i]);
+        let cross = lanes(&|i| ax[i] * by[i] - ay[i] * bx[i]);
+        // The cone's sides: along A's line on the side where B . d < 0, along B's line on the
+        // side where A . d > 0; perp(A) = (-ay, ax) has B . perp(A) = cross and
+        // perp(B) = (-by, bx) has A . perp(B) = -cross.
+        let sign = lanes(&|i| if cross[i] > 0.0 { 1.0 } else { -1.0 });
+        let ta = lanes(&|i| direction_angle(ay[i] * sign[i], -ax[i] * sign[i]));
+        let tb = lanes(&|i| direction_angle(by[i] * sign[i], -bx[i] * sign[i]));
+        // The cone is convex: its arc is the shorter one between its sides.
+        let ccw = lanes(&|i| {
+            let d = tb[i] - ta[i];
+            if tb[i] >= ta[i] { d } else { d + TURN }
+        });
+        let lo = lanes(&|i| (if ccw[i] <= TURN / 2.0 { ta[i] } else { tb[i] }) - MARGIN);
+        let len = lanes(&|i| {
+            (if ccw[i] <= TURN / 2.0 {
+                ccw[i]
+            } else {
+                TURN - ccw[i]
+            }) + 2.0 * MARGIN
+        });
+        let lo = lanes(&|i| if lo[i] < 0.0 { lo[i] + TURN } else { lo[i] });
+        let hi = lanes(&|i| {
+            let h = lo[i] + len[i];
+            if h >= TURN { h - TURN } else { h }
+        });
+        std::array::from_fn(|i| Sector {
+            // A sector plane (nearly) parallel to the light plane, or two (nearly) parallel
+            // lines (an uncertain orientation of the cone's sides), or a sector too wide:
+            // leave it to the exact test.
+            narrow: (la2[i] > 1e-8 * ga2[i])
+                & (lb2[i] > 1e-8 * gb2[i])
+                & (cross[i] * cross[i] > 1e-6 * la2[i] * lb2[i])
+                & (len[i] < TURN / 2.0),
+            wraps: lo[i] > hi[i],
+            lo: bucket(lo[i]) as u32,
+            hi: bucket(hi[i]) as u32,
+        })
     }
 }
 
@@ -188,6 +278,15 @@ mod tests {
             let (mut exact, mut cand) = ([0u64; 2], [0u64; 2]);
             test.mask(&rel, &allowed, &mut exact);
             index.candidates(&test, &allowed, &mut cand);
+            // The batched form gives the same words in every lane: the test last in batches of
+            // 1 to 8, after the reversed edge's tests.
+            let m = 1 + (k as usize % BATCH);
+            let mut batch = vec![EdgeTest::new(p, c, mid + dir, mid - dir).unwrap_or(test); m - 1];
+            batch.push(test);
+            let mut out = vec![0u64; 2 * m];
+            let any = index.candidates_batch(&batch, &allowed, &mut out);
+            assert_eq!(out[2 * (m - 1)..], cand, "case {k}: batch lane {}", m - 1);
+            assert_eq!(any >> (m - 1) & 1 == 1, cand.iter().any(|w| *w != 0));
             for w in 0..2 {
                 assert_eq!(
                     exact[w] & !cand[w],

@@ -35,7 +35,7 @@ use shadow_core::technique::{Capabilities, Processor, SceneRef};
 use shadow_core::view_samples::ViewSample;
 use shadow_core::visibility::{PerSampleVisibility, PixelClass};
 
-use crate::angular::AngularIndex;
+use crate::angular::{AngularIndex, BATCH};
 use crate::centred::CentredEdge;
 use crate::constant::{eye_constant, integration_constants};
 use crate::counters::{Packed, WIDTHS, width_for};
@@ -135,7 +135,10 @@ struct Scratch {
     polygon: RelativePolygon,
     above: Vec<u64>,
     mask: Vec<u64>,
-    candidates: Vec<u64>,
+    /// Tests waiting for their candidates, and their weights.
+    batch: Vec<EdgeTest>,
+    batch_k: Vec<i64>,
+    batch_candidates: Vec<u64>,
     masks: Vec<u64>,
     weights: Vec<i64>,
     packed: Packed,
@@ -437,7 +440,19 @@ impl Dcs {
                 self.sample_setup(p, s, origin, indexed, scratch);
                 ready = true;
             }
-            self.covered_update(p, s, o, pair, &test, indexed, scratch, counts);
+            if indexed {
+                // Candidates a batch at a time (their sector arithmetic vectorises).
+                scratch.batch.push(test);
+                scratch.batch_k.push(pair.k as i64);
+                if scratch.batch.len() == BATCH {
+                    Self::indexed_updates(scratch, counts);
+                }
+            } else {
+                self.covered_update(p, s, o, pair, &test, scratch, counts);
+            }
+        }
+        if !scratch.batch.is_empty() {
+            Self::indexed_updates(scratch, counts);
         }
         if !ready {
             // No wedge: every sample has the integration constant.
@@ -565,14 +580,12 @@ impl Dcs {
                 .angular
                 .build(plane, p.shape.center, &scratch.positions);
         }
-        for v in [&mut scratch.mask, &mut scratch.candidates] {
-            v.clear();
-            v.resize(words, 0);
-        }
+        scratch.mask.clear();
+        scratch.mask.resize(words, 0);
     }
 
-    /// The samples one pair's edge covers (section 7.3 tables, angular candidates and the exact
-    /// test, or the exact test alone), appended to the pixel's updates when there is any.
+    /// The samples one pair's edge covers (section 7.3 tables, or the exact test on every
+    /// sample above the horizon), appended to the pixel's updates when there is any.
     #[allow(clippy::too_many_arguments)]
     fn covered_update(
         &self,
@@ -581,12 +594,11 @@ impl Dcs {
         o: DVec3,
         pair: &Pair,
         test: &EdgeTest,
-        indexed: bool,
         scratch: &mut Scratch,
         counts: &mut Counts,
     ) {
         counts.edge_tests += 1;
-        let (mask, cand) = (&mut scratch.mask, &mut scratch.candidates);
+        let mask = &mut scratch.mask;
         let any = match (&self.covered, &p.tables) {
             (CoveredSamples::Discrete | CoveredSamples::Refined, Some(t)) => t.mask(
                 s.pixel,
@@ -597,18 +609,6 @@ impl Dcs {
                 &scratch.above,
                 mask,
             ),
-            _ if indexed => {
-                if !scratch.angular.candidates(test, &scratch.above, cand) {
-                    counts.sector_empty += 1;
-                    false
-                } else if cand.iter().map(|w| w.count_ones()).sum::<u32>() <= FEW_CANDIDATES {
-                    mask.fill(0);
-                    test.add_covered(&scratch.relative, cand, mask);
-                    mask.iter().any(|w| *w != 0)
-                } else {
-                    test.mask(&scratch.relative, cand, mask)
-                }
-            }
             _ => test.mask(&scratch.relative, &scratch.above, mask),
         };
         if any {
@@ -616,6 +616,42 @@ impl Dcs {
             scratch.masks.extend_from_slice(mask);
             scratch.weights.push(pair.k as i64);
         }
+    }
+
+    /// The covered samples of the batched tests (`scratch.batch`, emptied): their angular
+    /// candidates, then the exact test on those, appended to the pixel's updates when any.
+    fn indexed_updates(scratch: &mut Scratch, counts: &mut Counts) {
+        let words = scratch.above.len();
+        let n = scratch.batch.len();
+        scratch.batch_candidates.resize(BATCH * words, 0);
+        let any = scratch.angular.candidates_batch(
+            &scratch.batch,
+            &scratch.above,
+            &mut scratch.batch_candidates,
+        );
+        counts.edge_tests += n as u64;
+        for (i, (test, k)) in scratch.batch.iter().zip(&scratch.batch_k).enumerate() {
+            if any >> i & 1 == 0 {
+                counts.sector_empty += 1;
+                continue;
+            }
+            let cand = &scratch.batch_candidates[i * words..(i + 1) * words];
+            let mask = &mut scratch.mask;
+            let covered = if cand.iter().map(|w| w.count_ones()).sum::<u32>() <= FEW_CANDIDATES {
+                mask.fill(0);
+                test.add_covered(&scratch.relative, cand, mask);
+                mask.iter().any(|w| *w != 0)
+            } else {
+                test.mask(&scratch.relative, cand, mask)
+            };
+            if covered {
+                counts.covered_updates += 1;
+                scratch.masks.extend_from_slice(mask);
+                scratch.weights.push(*k);
+            }
+        }
+        scratch.batch.clear();
+        scratch.batch_k.clear();
     }
 
     /// Direct illumination of every view sample by DCS eq. 6: the light samples' contributions
