@@ -71,7 +71,7 @@ struct Prepared {
     tables: Option<DiscreteTables>,
     /// The planar light's convex polygon around its centre, for [`EdgeTest::may_cover`].
     polygon: Option<Vec<Vec3>>,
-    /// Every edge around the light centre (same indices as `edges`).
+    /// The silhouette edges around the light centre (same indices as `silhouettes`).
     centred_edges: Vec<CentredEdge>,
 }
 
@@ -604,7 +604,7 @@ impl Dcs {
                 s.pixel,
                 test,
                 o,
-                &p.edges[pair.edge as usize],
+                &p.edges[p.silhouettes[pair.edge as usize] as usize],
                 &scratch.relative,
                 &scratch.above,
                 mask,
@@ -795,7 +795,10 @@ impl ShadowTechnique for Dcs {
                 .collect()
         });
         let cd = shape.center.as_dvec3();
-        let centred_edges = edges.iter().map(|e| CentredEdge::new(e, cd)).collect();
+        let centred_edges = sil
+            .iter()
+            .map(|&i| CentredEdge::new(&edges[i as usize], cd))
+            .collect();
         self.prepared = Some(Prepared {
             polygon,
             centred_edges,

@@ -24,7 +24,8 @@ use crate::light_shape::LightShape;
 /// One (pixel, silhouette edge) pair: the edge and its weight `k_e(p)`.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Pair {
-    /// Index into the scene edge list.
+    /// Index into the silhouette list (of scene edge indices), which keeps the edges a frame
+    /// touches together.
     pub edge: u32,
     /// `k_e(p)`: positive for the outer part of the wedge, negative for the inner part.
     pub k: i32,
@@ -55,6 +56,8 @@ impl WedgePairs {
 #[derive(Debug, Clone)]
 pub(crate) struct Region {
     edge: u32,
+    /// The edge's position in the silhouette list.
+    sil: u32,
     /// Convex polygon in pixel units; `None` scans the whole image.
     poly: Option<Vec<DVec2>>,
     rows: (u32, u32),
@@ -241,7 +244,8 @@ pub(crate) fn wedge_regions(
     let hull: Vec<DVec3> = light.hull.iter().map(|p| p.as_dvec3()).collect();
     let regions: Vec<Region> = silhouettes
         .par_iter()
-        .filter_map(|&ei| {
+        .enumerate()
+        .filter_map(|(si, &ei)| {
             let e = &edges[ei as usize];
             let planes = wedge_planes(e, &hull, c);
             let fold = fold_planes(e);
@@ -257,6 +261,7 @@ pub(crate) fn wedge_regions(
             };
             Some(Region {
                 edge: ei,
+                sil: si as u32,
                 poly,
                 rows,
                 centred_planes: planes.iter().map(|p| p.centred(c)).collect(),
@@ -382,7 +387,7 @@ pub(crate) fn band_pairs(
                 };
                 if k != 0 {
                     let k = k.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
-                    found.push(((i - first) as u32, Pair { edge: r.edge, k }));
+                    found.push(((i - first) as u32, Pair { edge: r.sil, k }));
                 }
             }
         }
