@@ -345,11 +345,16 @@ pub(crate) fn band_pairs(
         };
         let e = &edges[r.edge as usize];
         let mut t = xmin / TILE_W;
+        // The group whose box passed, tested once for all its tiles.
+        let mut passed = usize::MAX;
         while t <= xmax / TILE_W {
             let g = t as usize / GROUP;
-            if groups[g].is_none_or(|(lo, hi)| rejects(r, lo, hi)) {
-                t = (g as u32 + 1) * GROUP as u32;
-                continue;
+            if g != passed {
+                if groups[g].is_none_or(|(lo, hi)| rejects(r, lo, hi)) {
+                    t = (g as u32 + 1) * GROUP as u32;
+                    continue;
+                }
+                passed = g;
             }
             let tc = t;
             t += 1;
