@@ -72,9 +72,18 @@ impl AngularIndex {
             let b = bucket(direction_angle(d.dot(plane.u), d.dot(plane.v)));
             self.prefix[(b + 1) * words + k / 64] |= 1 << (k % 64);
         }
-        for j in 1..=BUCKETS {
-            for w in 0..words {
-                self.prefix[j * words + w] |= self.prefix[(j - 1) * words + w];
+        if words == 1 {
+            let mut acc = 0;
+            for x in &mut self.prefix {
+                acc |= *x;
+                *x = acc;
+            }
+        } else {
+            for j in 1..=BUCKETS {
+                let (done, rest) = self.prefix.split_at_mut(j * words);
+                for (x, below) in rest[..words].iter_mut().zip(&done[(j - 1) * words..]) {
+                    *x |= *below;
+                }
             }
         }
     }
@@ -244,6 +253,13 @@ mod tests {
     /// samples out.
     #[test]
     fn candidates_hold_every_covered_sample() {
+        // One word of samples (the running union's single-word path) and two.
+        for count in [64, 128] {
+            candidates_hold_every_covered_sample_of(count);
+        }
+    }
+
+    fn candidates_hold_every_covered_sample_of(count: u32) {
         let light = RectLight::facing(
             Vec3::new(0.2, 3.0, -0.1),
             Vec3::NEG_Y,
@@ -254,7 +270,7 @@ mod tests {
         .unwrap();
         let shape = LightShape::new(&light, "test").unwrap();
         let plane = shape.plane.clone().unwrap();
-        let sampler = LightSampler::new(SamplingStrategy::Stratified, 128, 3).unwrap();
+        let sampler = LightSampler::new(SamplingStrategy::Stratified, count, 3).unwrap();
         let c = shape.center.as_dvec3();
         let (mut units, mut rel, mut index) = (
             Vec::new(),
@@ -274,8 +290,9 @@ mod tests {
             let pos: Vec<Vec3> = units.iter().map(|u| light.sample(*u).position).collect();
             rel.set(p.as_vec3(), &pos);
             index.build(&plane, shape.center, &pos);
-            let allowed = [u64::MAX; 2];
-            let (mut exact, mut cand) = ([0u64; 2], [0u64; 2]);
+            let words = count as usize / 64;
+            let allowed = vec![u64::MAX; words];
+            let (mut exact, mut cand) = (vec![0u64; words], vec![0u64; words]);
             test.mask(&rel, &allowed, &mut exact);
             index.candidates(&test, &allowed, &mut cand);
             // The batched form gives the same words in every lane: the test last in batches of
@@ -283,11 +300,16 @@ mod tests {
             let m = 1 + (k as usize % BATCH);
             let mut batch = vec![EdgeTest::new(p, c, mid + dir, mid - dir).unwrap_or(test); m - 1];
             batch.push(test);
-            let mut out = vec![0u64; 2 * m];
+            let mut out = vec![0u64; words * m];
             let any = index.candidates_batch(&batch, &allowed, &mut out);
-            assert_eq!(out[2 * (m - 1)..], cand, "case {k}: batch lane {}", m - 1);
+            assert_eq!(
+                out[words * (m - 1)..],
+                cand,
+                "case {k}: batch lane {}",
+                m - 1
+            );
             assert_eq!(any >> (m - 1) & 1 == 1, cand.iter().any(|w| *w != 0));
-            for w in 0..2 {
+            for w in 0..words {
                 assert_eq!(
                     exact[w] & !cand[w],
                     0,
@@ -296,7 +318,7 @@ mod tests {
                 covered += exact[w].count_ones();
                 candidates += cand[w].count_ones();
             }
-            total += 128;
+            total += count;
         }
         assert!(covered > 1000, "{covered}");
         // The cone holds little more than the covered samples, far fewer than all.
