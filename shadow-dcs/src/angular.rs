@@ -36,6 +36,8 @@ pub(crate) struct AngularIndex {
     /// `prefix[j * words + w]`: the samples of word `w` whose direction lies in a bucket below
     /// `j` (`BUCKETS + 1` entries per word).
     prefix: Vec<u64>,
+    /// Each sample's bucket (scratch of `build`).
+    buckets: Vec<u32>,
 }
 
 /// The direction of `(x, y)` as a monotone pseudo-angle in `[0, 4)` (the "diamond angle": 0
@@ -66,11 +68,15 @@ impl AngularIndex {
         self.v = plane.v;
         self.prefix.clear();
         self.prefix.resize((BUCKETS + 1) * words, 0);
-        // Bucket contents first (in entry j + 1), then the running union.
-        for (k, s) in positions.iter().enumerate() {
+        // Bucket contents first (in entry j + 1), then the running union. The buckets are
+        // computed sample by sample in one loop (which vectorises), then scattered.
+        self.buckets.clear();
+        self.buckets.extend(positions.iter().map(|s| {
             let d = *s - c;
-            let b = bucket(direction_angle(d.dot(plane.u), d.dot(plane.v)));
-            self.prefix[(b + 1) * words + k / 64] |= 1 << (k % 64);
+            bucket(direction_angle(d.dot(plane.u), d.dot(plane.v))) as u32
+        }));
+        for (k, b) in self.buckets.iter().enumerate() {
+            self.prefix[(*b as usize + 1) * words + k / 64] |= 1 << (k % 64);
         }
         if words == 1 {
             let mut acc = 0;
