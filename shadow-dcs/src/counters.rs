@@ -131,8 +131,20 @@ impl Packed {
         Ok(())
     }
 
+    /// Appends every counter, in order, to `out` (lane by lane, without a division each).
+    pub fn unpack_into(&self, out: &mut Vec<u64>) {
+        let lanes = (64 / self.bits) as usize;
+        let max = Self::lane_max(self.bits);
+        let mut left = self.n;
+        for &w in &self.words {
+            let take = left.min(lanes);
+            out.extend((0..take).map(|j| (w >> (j as u32 * self.bits)) & max));
+            left -= take;
+        }
+    }
+
     /// Counter `i`.
-    #[inline]
+    #[cfg(test)]
     pub fn get(&self, i: usize) -> u64 {
         let lanes = (64 / self.bits) as usize;
         (self.words[i / lanes] >> ((i % lanes) as u32 * self.bits)) & Self::lane_max(self.bits)
@@ -190,6 +202,9 @@ mod tests {
             for i in 0..n {
                 assert_eq!(p.get(i), plain[i], "bits {bits} counter {i}");
             }
+            let mut all = Vec::new();
+            p.unpack_into(&mut all);
+            assert_eq!(all, plain, "bits {bits}: unpacked");
         }
     }
 

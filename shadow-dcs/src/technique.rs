@@ -490,7 +490,7 @@ impl Dcs {
             )
             .is_ok()
             {
-                scratch.depth.extend((0..n).map(|k| scratch.packed.get(k)));
+                scratch.packed.unpack_into(&mut scratch.depth);
                 done = true;
                 break;
             }
@@ -515,9 +515,17 @@ impl Dcs {
                 .extend(scratch.plain.iter().map(|&d| d.max(0) as u64));
         }
         let (mut lit, mut dark) = (true, true);
+        // One unit per occluder (no semi-opaque scene): the visibility is whether the depth
+        // complexity is 0, as the general expression gives it.
+        let whole = units == 1.0;
         for k in 0..n {
             let v = if scratch.above[k / 64] >> (k % 64) & 1 == 1 {
-                1.0 - (scratch.depth[k] as f32 / units).min(1.0)
+                let d = scratch.depth[k];
+                if whole {
+                    if d == 0 { 1.0 } else { 0.0 }
+                } else {
+                    1.0 - (d as f32 / units).min(1.0)
+                }
             } else {
                 scratch.depth[k] = u64::MAX;
                 0.0
