@@ -44,7 +44,7 @@ use crate::discrete::{CoveredSamples, DiscreteTables};
 use crate::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
 use crate::lanes::BAND_ROWS;
 use crate::light_shape::LightShape;
-use crate::wedges::{Pair, Region, band_pairs, region_rows, wedge_regions};
+use crate::wedges::{Pair, Region, WedgePairs, band_pairs, region_rows, wedge_regions};
 
 /// What per-sample visibility an estimate returns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -145,6 +145,15 @@ struct Scratch {
     plain: Vec<i64>,
     depth: Vec<u64>,
     vis: Vec<f32>,
+}
+
+/// Per-thread buffers of a band: its pairs, their unsorted list, and the pixels' scratch
+/// (kept from band to band, so that they are allocated once per thread).
+#[derive(Default)]
+struct BandScratch {
+    pairs: WedgePairs,
+    found: Vec<(u32, Pair)>,
+    scratch: Scratch,
 }
 
 /// Work counters of a row of pixels.
@@ -331,10 +340,16 @@ impl Dcs {
         f: &Frame,
         rows: (u32, u32),
         counts: &mut Counts,
+        band: &mut BandScratch,
         mut visit: impl FnMut(usize, &ViewSample, PixelClass, &Scratch),
     ) {
         let view = f.view;
-        let pairs = band_pairs(
+        let BandScratch {
+            pairs,
+            found,
+            scratch,
+        } = band;
+        band_pairs(
             &p.edges,
             &f.regions,
             &f.region_rows,
@@ -345,15 +360,16 @@ impl Dcs {
             &f.centred,
             &f.active,
             p.extent,
+            pairs,
+            found,
         );
         counts.scanned += pairs.scanned;
         counts.pairs += pairs.entries.len() as u64;
         let w = view.width() as usize;
-        let mut scratch = Scratch::default();
         for i in rows.0 as usize * w..(rows.1 as usize + 1) * w {
             let Some(s) = view.get(i) else { continue };
-            let class = self.pixel(p, f, i, &s, pairs.of(i), &mut scratch, counts);
-            visit(i, &s, class, &scratch);
+            let class = self.pixel(p, f, i, &s, pairs.of(i), scratch, counts);
+            visit(i, &s, class, scratch);
         }
     }
 
@@ -675,13 +691,13 @@ impl Dcs {
         let bands = Self::bands(view);
         let parts: Vec<Vec<Vec3>> = bands
             .par_iter()
-            .map(|&rows| {
+            .map_init(BandScratch::default, |band, &rows| {
                 let first = rows.0 as usize * w;
                 let mut out = vec![Vec3::ZERO; (rows.1 - rows.0 + 1) as usize * w];
                 let mut counts = Counts::default();
                 let mut units = Vec::new();
                 let mut samples = Vec::new();
-                self.run_band(p, &f, rows, &mut counts, |i, s, _, scratch| {
+                self.run_band(p, &f, rows, &mut counts, band, |i, s, _, scratch| {
                     let light = p.light.as_ref();
                     let samples: &[LightSample] = if scratch.samples.is_empty() {
                         self.sampler.unit_samples(s.pixel, &mut units);
@@ -844,7 +860,7 @@ impl ShadowTechnique for Dcs {
         let rows: Vec<Row> = stats.time("depth-complexity", || {
             bands
                 .par_iter()
-                .map(|&rows| {
+                .map_init(BandScratch::default, |band, &rows| {
                     let m = (rows.1 - rows.0 + 1) as usize * w;
                     let first = rows.0 as usize * w;
                     let mut r = Row {
@@ -870,7 +886,7 @@ impl ShadowTechnique for Dcs {
                         counts: Counts::default(),
                     };
                     let mut counts = Counts::default();
-                    self.run_band(p, &f, rows, &mut counts, |i, _, class, scratch| {
+                    self.run_band(p, &f, rows, &mut counts, band, |i, _, class, scratch| {
                         let x = i - first;
                         r.class[x] = class;
                         let vis = &scratch.vis;

@@ -299,11 +299,18 @@ pub(crate) fn band_pairs(
     centred: &[Vec3],
     active: &[bool],
     scale: f64,
-) -> WedgePairs {
+    out: &mut WedgePairs,
+    found: &mut Vec<(u32, Pair)>,
+) {
     let w = view.width as usize;
     let first = rows.0 as usize * w;
     let n = (rows.1 - rows.0 + 1) as usize * w;
-    let mut found: Vec<(u32, Pair)> = Vec::new();
+    found.clear();
+    out.first = first;
+    out.scanned = 0;
+    out.entries.clear();
+    out.start.clear();
+    out.start.resize(n + 1, 0);
     let mut scanned = 0u64;
     let lanes = band_lanes(view.width, rows, centred, active);
     let tiles: Vec<TileBox> = lanes.iter().map(TileLanes::bounds).collect();
@@ -311,12 +318,7 @@ pub(crate) fn band_pairs(
     let band_box = union_boxes(&groups);
     let slack = (FOLD_SLACK * scale) as f32;
     let Some((band_lo, band_hi)) = band_box else {
-        return WedgePairs {
-            first,
-            start: vec![0; n + 1],
-            entries: Vec::new(),
-            scanned: 0,
-        };
+        return;
     };
     let no_silhouette = |r: &Region, lo: Vec3, hi: Vec3| -> bool {
         r.centred_fold
@@ -397,27 +399,26 @@ pub(crate) fn band_pairs(
             }
         }
     }
-    let mut start = vec![0u32; n + 1];
-    for (j, _) in &found {
+    // Counting sort by pixel, stable: each pixel's pairs stay in edge order. `start[j + 1]`
+    // first counts pixel `j`'s pairs, then serves as its fill position, which ends at the
+    // start of pixel `j + 1`.
+    let start = &mut out.start;
+    for (j, _) in found.iter() {
         start[*j as usize + 1] += 1;
     }
     for j in 0..n {
         start[j + 1] += start[j];
     }
-    // Counting sort by pixel, stable: each pixel's pairs stay in edge order.
-    let mut fill = start.clone();
-    let mut entries = vec![Pair { edge: 0, k: 0 }; found.len()];
-    for (j, pair) in found {
-        let slot = &mut fill[j as usize];
-        entries[*slot as usize] = pair;
+    out.entries.resize(found.len(), Pair { edge: 0, k: 0 });
+    for (j, pair) in found.iter() {
+        let slot = &mut start[*j as usize];
+        out.entries[*slot as usize] = *pair;
         *slot += 1;
     }
-    WedgePairs {
-        first,
-        start,
-        entries,
-        scanned,
-    }
+    // Each `start[j]` now holds the start of pixel `j + 1`: shift back.
+    start.copy_within(0..n, 1);
+    start[0] = 0;
+    out.scanned = scanned;
 }
 
 /// The columns whose pixel centres a convex polygon may cover on rows `y0..=y1` (the union of
