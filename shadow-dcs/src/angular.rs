@@ -10,7 +10,9 @@
 //! turn); prefix masks over the buckets then give, with two loads and two bit operations, every
 //! sample whose direction lies in the cone's arc widened by [`MARGIN`]. Most wedge pairs of a
 //! finely tessellated mesh have thin sectors holding no sample at all and are dropped without a
-//! per-sample test.
+//! per-sample test. The technique asks for the candidates of [`BATCH`] tests at a time
+//! ([`AngularIndex::candidates_batch`]): each step of the sectors' arithmetic is a loop over
+//! the batch, which the compiler turns into packed instructions.
 
 use glam::Vec3;
 

@@ -397,7 +397,8 @@ impl Dcs {
     }
 
     /// Per-sample visibility of pixel `i` into `scratch.vis` (and depth complexities into
-    /// `scratch.depth`), the light samples in `scratch.samples` when the light is textured (their radiances weigh eq. 2). Returns the class.
+    /// `scratch.depth`), and its light samples into `scratch.samples` when the light is
+    /// textured (their radiances weigh eq. 2). Returns the class.
     fn pixel(
         &self,
         p: &Prepared,
