@@ -101,22 +101,16 @@ impl AngularIndex {
     /// takes its tests a batch at a time, [`AngularIndex::candidates_batch`].)
     #[cfg(test)]
     pub fn candidates(&self, test: &EdgeTest, allowed: &[u64], out: &mut [u64]) -> bool {
-        let (ga, gb) = test.sector_normals();
-        let n = Normals::from([(ga, gb)].as_slice());
-        self.apply(n.sectors(self.u, self.v)[0], allowed, out)
+        self.candidates_batch(std::slice::from_ref(test), allowed, out) != 0
     }
 
     /// [`AngularIndex::candidates`] of up to [`BATCH`] tests at once, `tests.len() * words`
     /// words into `out`: the sectors' bucket ranges are computed lane by lane over the batch
-    /// (the same operations in the same order, so the same ranges), which the compiler turns
+    /// (the same operations in the same order whatever the lane), which the compiler turns
     /// into vector instructions. Returns the mask of tests with any candidate.
     pub fn candidates_batch(&self, tests: &[EdgeTest], allowed: &[u64], out: &mut [u64]) -> u32 {
         debug_assert!(tests.len() <= BATCH);
-        let mut normals = [(Vec3::ZERO, Vec3::ZERO); BATCH];
-        for (n, t) in normals.iter_mut().zip(tests) {
-            *n = t.sector_normals();
-        }
-        let sectors = Normals::from(normals.as_slice()).sectors(self.u, self.v);
+        let sectors = Normals::of(tests).sectors(self.u, self.v);
         let w = self.words;
         let mut any = 0u32;
         for (i, s) in sectors.iter().take(tests.len()).enumerate() {
@@ -159,7 +153,7 @@ impl AngularIndex {
 pub(crate) const BATCH: usize = 8;
 
 /// A sector as a range of buckets.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy)]
 struct Sector {
     /// False when the index cannot narrow the sector (every sample is a candidate).
     narrow: bool,
@@ -175,13 +169,15 @@ struct Normals {
     b: [[f32; BATCH]; 3],
 }
 
-impl From<&[(Vec3, Vec3)]> for Normals {
-    fn from(g: &[(Vec3, Vec3)]) -> Self {
+impl Normals {
+    /// The sector normals of up to [`BATCH`] tests (unused lanes zero).
+    fn of(tests: &[EdgeTest]) -> Self {
         let mut n = Normals {
             a: [[0.0; BATCH]; 3],
             b: [[0.0; BATCH]; 3],
         };
-        for (i, (ga, gb)) in g.iter().enumerate().take(BATCH) {
+        for (i, t) in tests.iter().enumerate().take(BATCH) {
+            let (ga, gb) = t.sector_normals();
             for k in 0..3 {
                 n.a[k][i] = ga[k];
                 n.b[k][i] = gb[k];

@@ -400,8 +400,8 @@ pub(crate) fn band_pairs(
         }
     }
     // Counting sort by pixel, stable: each pixel's pairs stay in edge order. `start[j + 1]`
-    // first counts pixel `j`'s pairs, then serves as its fill position, which ends at the
-    // start of pixel `j + 1`.
+    // first counts pixel `j`'s pairs; after the running sum, `start[j]` is pixel `j`'s fill
+    // position, which ends at the start of pixel `j + 1`.
     let start = &mut out.start;
     for (j, _) in found.iter() {
         start[*j as usize + 1] += 1;
