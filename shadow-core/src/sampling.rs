@@ -73,7 +73,13 @@ pub struct LightSampler {
     grid: UVec2,
     /// Shared sets: one for correlated/decorrelated, `tile^2` for interleaved.
     sets: Vec<Vec<Vec2>>,
+    /// Each cell's hash key, `mix64(k ^ CELL_SALT)`: the part of a jittered sample's hash that
+    /// does not depend on the set, computed once rather than per pixel.
+    cell_keys: Vec<u64>,
 }
+
+/// Salt of the cell index in a jittered sample's hash.
+const CELL_SALT: u64 = 0x6a09_e667_f3bc_c909;
 
 impl LightSampler {
     /// A sampler drawing `count` samples per pixel.
@@ -91,6 +97,9 @@ impl LightSampler {
             seed,
             grid,
             sets: Vec::new(),
+            cell_keys: (0..u64::from(count))
+                .map(|k| mix64(k ^ CELL_SALT))
+                .collect(),
         };
         s.sets = match strategy {
             SamplingStrategy::Correlated | SamplingStrategy::Decorrelated => {
@@ -137,17 +146,15 @@ impl LightSampler {
     fn jittered_into(&self, base: u64, out: &mut Vec<Vec2>) {
         // Row by row: sample `k` is cell `(k % grid.x, k / grid.x)`, without a division each.
         let (gx, gy) = (self.grid.x as f32, self.grid.y as f32);
-        let mut k = 0u64;
-        for cy in 0..self.grid.y {
-            for cx in 0..self.grid.x {
-                let h = mix64(base ^ mix64(k ^ 0x6a09_e667_f3bc_c909));
+        for (cy, row) in self.cell_keys.chunks(self.grid.x as usize).enumerate() {
+            for (cx, key) in row.iter().enumerate() {
+                let h = mix64(base ^ key);
                 let jx = unit_float(h);
                 let jy = unit_float(mix64(h));
                 out.push(Vec2::new(
                     ((cx as f32 + jx) / gx).min(ONE_MINUS),
                     ((cy as f32 + jy) / gy).min(ONE_MINUS),
                 ));
-                k += 1;
             }
         }
     }
@@ -208,6 +215,31 @@ mod tests {
         }
         assert_eq!(strata(1024), UVec2::new(32, 32));
         assert_eq!(strata(128), UVec2::new(16, 8));
+    }
+
+    /// Sample `k` of a stratified pixel is the point of cell `(k % x, k / x)` jittered by the
+    /// hash of the pixel's key and `k` (the per-cell key table only caches part of it).
+    #[test]
+    fn stratified_samples_follow_the_per_sample_hash() {
+        for n in [1, 7, 64, 128] {
+            let s = LightSampler::new(SamplingStrategy::Stratified, n, 9).unwrap();
+            let g = s.grid();
+            let mut out = Vec::new();
+            for pixel in [UVec2::new(0, 0), UVec2::new(17, 3)] {
+                s.unit_samples(pixel, &mut out);
+                assert_eq!(out.len(), n as usize);
+                let base = hash_words(&[9, 0x57, u64::from(pixel.x), u64::from(pixel.y)]);
+                for (k, u) in out.iter().enumerate() {
+                    let h = mix64(base ^ mix64(k as u64 ^ 0x6a09_e667_f3bc_c909));
+                    let (cx, cy) = (k as u32 % g.x, k as u32 / g.x);
+                    let want = Vec2::new(
+                        ((cx as f32 + unit_float(h)) / g.x as f32).min(ONE_MINUS),
+                        ((cy as f32 + unit_float(mix64(h))) / g.y as f32).min(ONE_MINUS),
+                    );
+                    assert_eq!(*u, want, "n {n} pixel {pixel} sample {k}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -436,7 +436,7 @@ impl Dcs {
         // pairs go straight to their candidates, which drop off-light pairs more cheaply.
         let o = origin.as_dvec3();
         let pc = o - p.shape.center.as_dvec3();
-        if let Some(poly) = &p.polygon {
+        if let (Some(poly), false) = (&p.polygon, entries.is_empty()) {
             scratch.polygon.set(poly, f.centred[i]);
         }
         let indexed = p.shape.plane.is_some() && self.covered == CoveredSamples::Exact;
