@@ -188,7 +188,7 @@ impl LightSampler {
         let mut u = Vec::with_capacity(self.count as usize);
         self.unit_samples(pixel, &mut u);
         out.clear();
-        out.extend(u.iter().map(|u| light.sample(*u)));
+        light.sample_into(&u, out);
     }
 }
 

@@ -480,9 +480,7 @@ impl Dcs {
             if textured {
                 self.sampler.unit_samples(s.pixel, &mut scratch.units);
                 let light = p.light.as_ref();
-                scratch
-                    .samples
-                    .extend(scratch.units.iter().map(|u| light.sample(*u)));
+                light.sample_into(&scratch.units, &mut scratch.samples);
             }
             return if d0 == 0 {
                 PixelClass::Lit
@@ -577,16 +575,12 @@ impl Dcs {
         scratch.positions.clear();
         if light.is_textured() {
             // The radiances weigh the visibilities (eq. 2).
-            scratch
-                .samples
-                .extend(scratch.units.iter().map(|u| light.sample(*u)));
+            light.sample_into(&scratch.units, &mut scratch.samples);
             scratch
                 .positions
                 .extend(scratch.samples.iter().map(|l| l.position));
         } else {
-            scratch
-                .positions
-                .extend(scratch.units.iter().map(|u| light.point_at(*u).0));
+            light.positions_into(&scratch.units, &mut scratch.positions);
         }
         // Samples above the horizon (the reference's rule).
         scratch.above.clear();
@@ -703,7 +697,7 @@ impl Dcs {
                     let samples: &[LightSample] = if scratch.samples.is_empty() {
                         self.sampler.unit_samples(s.pixel, &mut units);
                         samples.clear();
-                        samples.extend(units.iter().map(|u| light.sample(*u)));
+                        light.sample_into(&units, &mut samples);
                         &samples
                     } else {
                         &scratch.samples

@@ -220,7 +220,7 @@ impl Reference {
             return;
         }
         self.sampler.unit_samples(pixel, units);
-        out.extend(units.iter().map(|u| light.sample(*u)));
+        light.sample_into(units, out);
     }
 
     /// The occlusion segment from view sample `s` to light point `y`: robust origin, unit

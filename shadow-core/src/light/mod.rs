@@ -245,6 +245,16 @@ pub trait AreaLight: Send + Sync + Debug {
             radiance: self.radiance().at(uv),
         }
     }
+    /// The samples at every `u` of `units`, appended to `out`: one dynamic call for a whole
+    /// set, inside which [`AreaLight::sample`] is a static call the compiler can inline.
+    fn sample_into(&self, units: &[Vec2], out: &mut Vec<LightSample>) {
+        out.extend(units.iter().map(|u| self.sample(*u)));
+    }
+    /// The positions at every `u` of `units` ([`AreaLight::point_at`]), appended to `out`, one
+    /// dynamic call for a whole set.
+    fn positions_into(&self, units: &[Vec2], out: &mut Vec<Vec3>) {
+        out.extend(units.iter().map(|u| self.point_at(*u).0));
+    }
     /// Family of the light.
     fn kind(&self) -> LightKind {
         self.geometry().kind()

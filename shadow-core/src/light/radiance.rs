@@ -125,22 +125,93 @@ impl TexturedRadiance {
         let st = self.texture_from_light.transform_point2(uv);
         let x = st.x * self.width as f32 - 0.5;
         let y = st.y * self.height as f32 - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
+        let (x0, y0) = (floor(x), floor(y));
         let (fx, fy) = (x - x0, y - y0);
-        let texel = |xi: f32, yi: f32| {
-            let xi = (xi as i64).rem_euclid(self.width as i64) as usize;
-            let yi = (yi as i64).rem_euclid(self.height as i64) as usize;
-            self.texels[yi * self.width as usize + xi]
-        };
-        let a = texel(x0, y0).lerp(texel(x0 + 1.0, y0), fx);
-        let b = texel(x0, y0 + 1.0).lerp(texel(x0 + 1.0, y0 + 1.0), fx);
+        let (xi, yi) = (x0 as i64, y0 as i64);
+        let (xa, xb) = (wrap(xi, self.width), wrap(xi.saturating_add(1), self.width));
+        let (ya, yb) = (
+            wrap(yi, self.height),
+            wrap(yi.saturating_add(1), self.height),
+        );
+        let w = self.width as usize;
+        let texel = |xi: usize, yi: usize| self.texels[yi * w + xi];
+        let a = texel(xa, ya).lerp(texel(xb, ya), fx);
+        let b = texel(xa, yb).lerp(texel(xb, yb), fx);
         a.lerp(b, fy) * self.scale
+    }
+}
+
+/// `x.floor()` without a library call on targets without a rounding instruction (the
+/// baseline x86-64 has none): truncation, one down for negative fractions. Equal to
+/// `f32::floor` for every finite `x` (above `2^23` every float is an integer, which the
+/// round trip through `i64` keeps); non-finite values go through `f32::floor`.
+#[inline]
+fn floor(x: f32) -> f32 {
+    if x.abs() < 9.0e18 {
+        let t = x as i64 as f32;
+        if t > x { t - 1.0 } else { t }
+    } else {
+        x.floor()
+    }
+}
+
+/// The texel index `i` wrapped into `0..n` (repeat addressing); a division only outside.
+#[inline]
+fn wrap(i: i64, n: u32) -> usize {
+    let n = i64::from(n);
+    if (0..n).contains(&i) {
+        i as usize
+    } else {
+        i.rem_euclid(n) as usize
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The lookup equals bilinear filtering with `f32::floor` and Euclidean wrapping, inside
+    /// the texture and tiled around it, and the fast floor equals `f32::floor`.
+    #[test]
+    fn lookup_equals_the_plain_bilinear_filter() {
+        let (w, h) = (5u32, 3u32);
+        let texels: Vec<Vec3> = (0..w * h)
+            .map(|k| Vec3::new(k as f32, (k * 7 % 11) as f32, (k * 3 % 5) as f32))
+            .collect();
+        let tex = TexturedRadiance::new(
+            w,
+            h,
+            texels.clone(),
+            Vec3::ONE,
+            Affine2::from_scale(Vec2::new(1.5, -2.25)),
+        )
+        .unwrap();
+        let plain = |uv: Vec2| {
+            let st = tex.texture_from_light.transform_point2(uv);
+            let (x, y) = (st.x * w as f32 - 0.5, st.y * h as f32 - 0.5);
+            let (x0, y0) = (x.floor(), y.floor());
+            let t = |xi: f32, yi: f32| {
+                let xi = (xi as i64).rem_euclid(i64::from(w)) as usize;
+                let yi = (yi as i64).rem_euclid(i64::from(h)) as usize;
+                texels[yi * w as usize + xi]
+            };
+            let a = t(x0, y0).lerp(t(x0 + 1.0, y0), x - x0);
+            let b = t(x0, y0 + 1.0).lerp(t(x0 + 1.0, y0 + 1.0), x - x0);
+            a.lerp(b, y - y0)
+        };
+        for k in 0..2000u64 {
+            let r = |i: u64| crate::sampling::unit_float(crate::sampling::hash_words(&[k, i]));
+            let uv = Vec2::new(r(0) * 6.0 - 3.0, r(1) * 6.0 - 3.0);
+            assert_eq!(tex.at(uv), plain(uv), "uv {uv}");
+        }
+        for x in [
+            0.0, -0.0, 0.5, -0.5, -1.0, 2.75, -2.75, 8388607.5, -8388609.0, 1e20, -1e20,
+        ] {
+            assert_eq!(floor(x), x.floor(), "{x}");
+        }
+        assert!(floor(f32::NAN).is_nan());
+        assert_eq!(floor(f32::NEG_INFINITY), f32::NEG_INFINITY);
+    }
 
     #[test]
     fn texture_lookup_and_mean() {
