@@ -116,6 +116,10 @@ struct Frame<'a> {
 /// at a time.
 const FEW_CANDIDATES: u32 = 12;
 
+/// Fewest wedge pairs for which a pixel builds its angular index: below, the exact test on
+/// every sample costs less than the index.
+const INDEX_MIN_PAIRS: usize = 6;
+
 /// Where the light lies relative to a receiver's tangent plane.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Horizon {
@@ -439,7 +443,9 @@ impl Dcs {
         if let (Some(poly), false) = (&p.polygon, entries.is_empty()) {
             scratch.polygon.set(poly, f.centred[i]);
         }
-        let indexed = p.shape.plane.is_some() && self.covered == CoveredSamples::Exact;
+        let indexed = p.shape.plane.is_some()
+            && self.covered == CoveredSamples::Exact
+            && entries.len() >= INDEX_MIN_PAIRS;
         let mut ready = horizon == Horizon::Mixed;
         if ready {
             self.sample_setup(p, s, origin, indexed, scratch);
