@@ -120,10 +120,19 @@ const FEW_CANDIDATES: u32 = 12;
 /// every sample costs less than the index.
 const INDEX_MIN_PAIRS: usize = 6;
 
+/// Relative error bound of the per-sample horizon test in `f32`, against
+/// `|n| (|c| + r + |p|)` (normal, light centre and radius, receiver): a light whose every point
+/// lies above both tangent planes by more than this has every sample above them.
+const HORIZON_BOUND: f64 = 1e-5;
+
 /// Where the light lies relative to a receiver's tangent plane.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Horizon {
+    /// The whole light above both planes, by more than the per-sample test's rounding.
     Above,
+    /// The whole light above both planes, but within rounding of one: every sample above the
+    /// planes in exact arithmetic, tested one by one as the reference does.
+    Grazing,
     Below,
     Mixed,
 }
@@ -391,8 +400,18 @@ impl Dcs {
         let n = s.geometric_normal.as_dvec3();
         let (lo1, hi1) = shape.range(n, -n.dot(s.position.as_dvec3()));
         let (lo2, hi2) = shape.range(n, -n.dot(origin.as_dvec3()));
-        if lo1 > 0.0 && lo2 > 0.0 {
+        let reach = shape.center.as_dvec3().length() + f64::from(shape.radius);
+        let bound = HORIZON_BOUND
+            * n.length()
+            * (reach
+                + s.position
+                    .as_dvec3()
+                    .length()
+                    .max(origin.as_dvec3().length()));
+        if lo1 > bound && lo2 > bound {
             Horizon::Above
+        } else if lo1 > 0.0 && lo2 > 0.0 {
+            Horizon::Grazing
         } else if !(hi1 > 0.0 && hi2 > 0.0) {
             Horizon::Below
         } else {
@@ -448,7 +467,7 @@ impl Dcs {
             && entries.len() >= INDEX_MIN_PAIRS;
         let mut ready = horizon == Horizon::Mixed;
         if ready {
-            self.sample_setup(p, s, origin, indexed, scratch);
+            self.sample_setup(p, s, origin, indexed, horizon == Horizon::Above, scratch);
         }
         for pair in entries {
             let Some(test) = p.centred_edges[pair.edge as usize].test(pc) else {
@@ -460,7 +479,7 @@ impl Dcs {
                 continue;
             }
             if !ready {
-                self.sample_setup(p, s, origin, indexed, scratch);
+                self.sample_setup(p, s, origin, indexed, horizon == Horizon::Above, scratch);
                 ready = true;
             }
             if indexed {
@@ -572,9 +591,11 @@ impl Dcs {
         s: &ViewSample,
         origin: Vec3,
         indexed: bool,
+        all_above: bool,
         scratch: &mut Scratch,
     ) {
-        let words = (self.sampler.count() as usize).div_ceil(64);
+        let n = self.sampler.count() as usize;
+        let words = n.div_ceil(64);
         self.sampler.unit_samples(s.pixel, &mut scratch.units);
         let light = p.light.as_ref();
         scratch.samples.clear();
@@ -588,14 +609,24 @@ impl Dcs {
         } else {
             light.positions_into(&scratch.units, &mut scratch.positions);
         }
-        // Samples above the horizon (the reference's rule).
-        scratch.above.clear();
-        scratch.above.resize(words, 0);
-        let nrm = s.geometric_normal;
-        for (k, y) in scratch.positions.iter().enumerate() {
-            if (*y - s.position).dot(nrm) > 0.0 && (*y - origin).dot(nrm) > 0.0 {
-                scratch.above[k / 64] |= 1 << (k % 64);
+        // Samples above the horizon (the reference's rule), every one when the whole light is
+        // surely above.
+        if all_above {
+            scratch.above.clear();
+            scratch.above.resize(words, u64::MAX);
+            if !n.is_multiple_of(64) {
+                scratch.above[words - 1] = (1 << (n % 64)) - 1;
             }
+            if cfg!(debug_assertions) {
+                let mut check = Vec::new();
+                horizon_mask_into(&scratch.positions, s, origin, &mut check);
+                assert_eq!(
+                    scratch.above, check,
+                    "a light surely above the horizon has a sample below it"
+                );
+            }
+        } else {
+            horizon_mask_into(&scratch.positions, s, origin, &mut scratch.above);
         }
         scratch.masks.clear();
         scratch.weights.clear();
@@ -717,6 +748,19 @@ impl Dcs {
             .collect();
         let out: Vec<Vec3> = parts.into_iter().flatten().collect();
         Ok(out)
+    }
+}
+
+/// The samples of `positions` above the tangent plane both from the surface point and from the
+/// offset `origin` (the reference's rule), one bit each, into `above`.
+fn horizon_mask_into(positions: &[Vec3], s: &ViewSample, origin: Vec3, above: &mut Vec<u64>) {
+    above.clear();
+    above.resize(positions.len().div_ceil(64), 0);
+    let nrm = s.geometric_normal;
+    for (k, y) in positions.iter().enumerate() {
+        if (*y - s.position).dot(nrm) > 0.0 && (*y - origin).dot(nrm) > 0.0 {
+            above[k / 64] |= 1 << (k % 64);
+        }
     }
 }
 
