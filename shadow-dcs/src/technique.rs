@@ -465,9 +465,10 @@ impl Dcs {
         let indexed = p.shape.plane.is_some()
             && self.covered == CoveredSamples::Exact
             && entries.len() >= INDEX_MIN_PAIRS;
+        let all_above = horizon == Horizon::Above;
         let mut ready = horizon == Horizon::Mixed;
         if ready {
-            self.sample_setup(p, s, origin, indexed, horizon == Horizon::Above, scratch);
+            self.sample_setup(p, s, origin, indexed, all_above, scratch);
         }
         for pair in entries {
             let Some(test) = p.centred_edges[pair.edge as usize].test(pc) else {
@@ -479,7 +480,7 @@ impl Dcs {
                 continue;
             }
             if !ready {
-                self.sample_setup(p, s, origin, indexed, horizon == Horizon::Above, scratch);
+                self.sample_setup(p, s, origin, indexed, all_above, scratch);
                 ready = true;
             }
             if indexed {
