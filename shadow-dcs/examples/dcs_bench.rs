@@ -2,6 +2,9 @@
 //!
 //!     cargo run --release -p shadow-dcs --example dcs_bench -- [SCENE] [SIZE] [SAMPLES] [RUNS]
 //!
+//! `SAMPLES` is a number of stratified samples (the `dcs-64` configuration at 64) or the name
+//! of a DCS preset (`dcs-64-interleaved`, `dcs-64-discrete`, ...).
+//!
 //! Prints the best-of-`RUNS` wall time of each (all threads), DCS's phase times and counters of
 //! its last run, the ratio and the per-sample agreement; fails when agreement is below 99.9%.
 
@@ -15,14 +18,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let scene = args.first().map_or("bunny", String::as_str);
     let size: u32 = args.get(1).map_or(Ok(512), |s| s.parse())?;
-    let n: u32 = args.get(2).map_or(Ok(64), |s| s.parse())?;
+    let samples = args.get(2).map_or("64", String::as_str);
     let runs: u32 = args.get(3).map_or(Ok(5), |s| s.parse())?;
     let setup = shadow_core::scenes::builtin(scene)?;
     let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), size, size)?;
     let light = setup.lights[0].clone();
-    let mut dcs = Dcs::new(n, SamplingStrategy::Stratified, 1)?;
+    let mut dcs: Box<dyn ShadowTechnique> = match samples.parse::<u32>() {
+        Ok(n) => Box::new(Dcs::new(n, SamplingStrategy::Stratified, 1)?),
+        Err(_) => {
+            let preset = shadow_dcs::presets()
+                .into_iter()
+                .find(|p| p.name == samples)
+                .ok_or_else(|| format!("{samples}: neither a sample count nor a DCS preset"))?;
+            (preset.make)(1)
+        }
+    };
     dcs.prepare(setup.scene.clone(), light.clone())?;
     let sampler = dcs.light_sampler().ok_or("no sampler")?.clone();
+    let n = sampler.count();
     let mut r = Reference::same_samples(sampler);
     r.prepare(setup.scene.clone(), light)?;
     let best = |t: &mut dyn ShadowTechnique| -> Result<(f64, Estimate), TechniqueError> {
@@ -36,7 +49,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         Ok((secs, last.expect("at least one run")))
     };
-    let (td, ed) = best(&mut dcs)?;
+    let (td, ed) = best(dcs.as_mut())?;
     let (tr, er) = best(&mut r)?;
     let m = shadow_core::metrics::compare(&ed.visibility, &er.visibility)?;
     for p in &ed.stats.phases {
@@ -49,7 +62,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!();
     let agree = m.sample_agreement.unwrap_or(0.0);
     println!(
-        "{scene} {size}x{size}, {n} samples: DCS {td:.4}s, reference {tr:.4}s, DCS is {:.2}x the reference; agreement {agree:.7}",
+        "{scene} {size}x{size}, {samples} ({n} samples): DCS {td:.4}s, reference {tr:.4}s, DCS is {:.2}x the reference; agreement {agree:.7}",
         tr / td
     );
     if agree < 0.999 {

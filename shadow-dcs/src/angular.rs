@@ -101,24 +101,49 @@ impl AngularIndex {
     /// takes its tests a batch at a time, [`AngularIndex::candidates_batch`].)
     #[cfg(test)]
     pub fn candidates(&self, test: &EdgeTest, allowed: &[u64], out: &mut [u64]) -> bool {
-        self.candidates_batch(std::slice::from_ref(test), allowed, out) != 0
+        self.candidates_batch(std::slice::from_ref(test), allowed, out, None) != 0
     }
 
     /// [`AngularIndex::candidates`] of up to [`BATCH`] tests at once, `tests.len() * words`
     /// words into `out`: the sectors' bucket ranges are computed lane by lane over the batch
     /// (the same operations in the same order whatever the lane), which the compiler turns
     /// into vector instructions. Returns the mask of tests with any candidate.
-    pub fn candidates_batch(&self, tests: &[EdgeTest], allowed: &[u64], out: &mut [u64]) -> u32 {
+    ///
+    /// With `inner`, also the samples of `allowed` whose buckets lie wholly inside each sector
+    /// (narrowed by [`MARGIN`] at both ends, so that every one of them is in the exact test's
+    /// sector), `tests.len() * words` words: the refined tables of section 7.3 settle those by
+    /// their line alone.
+    pub fn candidates_batch(
+        &self,
+        tests: &[EdgeTest],
+        allowed: &[u64],
+        out: &mut [u64],
+        mut inner: Option<&mut [u64]>,
+    ) -> u32 {
         debug_assert!(tests.len() <= BATCH);
-        let sectors = Normals::of(tests).sectors(self.u, self.v);
+        let sectors = Normals::of(tests).sectors(self.u, self.v, inner.is_some());
         let w = self.words;
         let mut any = 0u32;
         for (i, s) in sectors.iter().take(tests.len()).enumerate() {
             if self.apply(*s, allowed, &mut out[i * w..(i + 1) * w]) {
                 any |= 1 << i;
             }
+            if let Some(inner) = inner.as_deref_mut() {
+                self.apply_inner(*s, allowed, &mut inner[i * w..(i + 1) * w]);
+            }
         }
         any
+    }
+
+    /// The samples of `allowed` in the inner buckets of `s` (none when it has none).
+    #[inline]
+    fn apply_inner(&self, s: Sector, allowed: &[u64], out: &mut [u64]) {
+        match s.inner.filter(|_| s.narrow) {
+            Some((lo, hi)) => {
+                self.buckets_into(lo, hi, lo > hi, allowed, out);
+            }
+            None => out.fill(0),
+        }
     }
 
     /// The samples of `allowed` in the buckets of `s` (all of `allowed` when the index cannot
@@ -129,7 +154,21 @@ impl AngularIndex {
             out.copy_from_slice(allowed);
             return allowed.iter().any(|w| *w != 0);
         }
-        let (bl, bh) = (s.lo as usize, s.hi as usize);
+        self.buckets_into(s.lo, s.hi, s.wraps, allowed, out)
+    }
+
+    /// The samples of `allowed` in the buckets from `lo` to `hi` (round past the last bucket
+    /// when `wraps`); returns whether there is any.
+    #[inline]
+    fn buckets_into(
+        &self,
+        lo: u32,
+        hi: u32,
+        wraps: bool,
+        allowed: &[u64],
+        out: &mut [u64],
+    ) -> bool {
+        let (bl, bh) = (lo as usize, hi as usize);
         let w = self.words;
         let (below_lo, upto_hi) = (
             &self.prefix[bl * w..bl * w + w],
@@ -137,7 +176,7 @@ impl AngularIndex {
         );
         let mut any = 0u64;
         for j in 0..w {
-            let range = if s.wraps {
+            let range = if wraps {
                 upto_hi[j] | !below_lo[j]
             } else {
                 upto_hi[j] & !below_lo[j]
@@ -161,6 +200,10 @@ struct Sector {
     wraps: bool,
     lo: u32,
     hi: u32,
+    /// The buckets wholly inside the sector shrunk by [`MARGIN`] at both ends, from the first
+    /// to the last (round past the last bucket when the first is greater); `None` when no
+    /// bucket is.
+    inner: Option<(u32, u32)>,
 }
 
 /// The sector normals of a batch of tests, structure of arrays.
@@ -189,8 +232,8 @@ impl Normals {
 
 impl Normals {
     /// The bucket ranges of the batch's sectors, each step lane by lane over the batch (loops
-    /// the compiler vectorises), branch-free.
-    fn sectors(&self, u: Vec3, v: Vec3) -> [Sector; BATCH] {
+    /// the compiler vectorises), branch-free; their inner buckets only `with_inner`.
+    fn sectors(&self, u: Vec3, v: Vec3, with_inner: bool) -> [Sector; BATCH] {
         type Lanes = [f32; BATCH];
         let lanes = |f: &dyn Fn(usize) -> f32| -> Lanes { std::array::from_fn(f) };
         let dot =
@@ -215,14 +258,34 @@ impl Normals {
             let d = tb[i] - ta[i];
             if tb[i] >= ta[i] { d } else { d + TURN }
         });
-        let lo = lanes(&|i| (if ccw[i] <= TURN / 2.0 { ta[i] } else { tb[i] }) - MARGIN);
-        let len = lanes(&|i| {
-            (if ccw[i] <= TURN / 2.0 {
+        let start = lanes(&|i| if ccw[i] <= TURN / 2.0 { ta[i] } else { tb[i] });
+        let arc = lanes(&|i| {
+            if ccw[i] <= TURN / 2.0 {
                 ccw[i]
             } else {
                 TURN - ccw[i]
-            }) + 2.0 * MARGIN
+            }
         });
+        let lo = lanes(&|i| start[i] - MARGIN);
+        let len = lanes(&|i| arc[i] + 2.0 * MARGIN);
+        // The inner buckets: those after the bucket of `start + MARGIN` and before that of
+        // `start + arc - MARGIN`.
+        let wrap = |a: f32| if a >= TURN { a - TURN } else { a };
+        let first = lanes(&|i| wrap(start[i] + MARGIN));
+        let last = lanes(&|i| wrap(start[i] + arc[i] - MARGIN));
+        let inner = |i: usize| -> Option<(u32, u32)> {
+            if !with_inner || !(arc[i] > 2.0 * MARGIN) {
+                return None;
+            }
+            let (bf, bl) = (bucket(first[i]), bucket(last[i]));
+            let span = (bl + BUCKETS - bf) % BUCKETS;
+            (span >= 2).then(|| {
+                (
+                    ((bf + 1) % BUCKETS) as u32,
+                    ((bl + BUCKETS - 1) % BUCKETS) as u32,
+                )
+            })
+        };
         let lo = lanes(&|i| if lo[i] < 0.0 { lo[i] + TURN } else { lo[i] });
         let hi = lanes(&|i| {
             let h = lo[i] + len[i];
@@ -239,6 +302,7 @@ impl Normals {
             wraps: lo[i] > hi[i],
             lo: bucket(lo[i]) as u32,
             hi: bucket(hi[i]) as u32,
+            inner: inner(i),
         })
     }
 }
@@ -281,7 +345,7 @@ mod tests {
             RelativeSamples::default(),
             AngularIndex::default(),
         );
-        let (mut covered, mut candidates, mut total) = (0u32, 0u32, 0u32);
+        let (mut covered, mut candidates, mut total, mut inner_total) = (0u32, 0u32, 0u32, 0u32);
         for k in 0..3000u64 {
             let r = |i: u64| unit_float(hash_words(&[k, i])) as f64 * 2.0 - 1.0;
             let p = DVec3::new(r(0) * 2.0, 0.0, r(1) * 2.0);
@@ -305,7 +369,7 @@ mod tests {
             let mut batch = vec![EdgeTest::new(p, c, mid + dir, mid - dir).unwrap_or(test); m - 1];
             batch.push(test);
             let mut out = vec![0u64; words * m];
-            let any = index.candidates_batch(&batch, &allowed, &mut out);
+            let any = index.candidates_batch(&batch, &allowed, &mut out, None);
             assert_eq!(
                 out[words * (m - 1)..],
                 cand,
@@ -313,7 +377,33 @@ mod tests {
                 m - 1
             );
             assert_eq!(any >> (m - 1) & 1 == 1, cand.iter().any(|w| *w != 0));
+            // The inner buckets hold candidates only, each inside the sector (the side of
+            // both sector planes, `s - p` in double precision, away from their planes).
+            let mut inner = vec![0u64; words];
+            index.candidates_batch(
+                std::slice::from_ref(&test),
+                &allowed,
+                &mut cand.clone(),
+                Some(&mut inner),
+            );
+            let (ga, gb) = test.sector_normals();
+            for (i, s) in pos.iter().enumerate() {
+                if inner[i / 64] >> (i % 64) & 1 == 1 {
+                    let d = s.as_dvec3() - p;
+                    let (fa, fb) = (ga.as_dvec3().dot(d), gb.as_dvec3().dot(d));
+                    assert!(
+                        fa > 0.0 && fb < 0.0,
+                        "case {k}: inner sample {i} outside the sector"
+                    );
+                    inner_total += 1;
+                }
+            }
             for w in 0..words {
+                assert_eq!(
+                    inner[w] & !cand[w],
+                    0,
+                    "case {k}: an inner sample is no candidate"
+                );
                 assert_eq!(
                     exact[w] & !cand[w],
                     0,
@@ -325,6 +415,11 @@ mod tests {
             total += count;
         }
         assert!(covered > 1000, "{covered}");
+        // Most candidates lie in inner buckets.
+        assert!(
+            inner_total > candidates / 2,
+            "{inner_total} of {candidates}"
+        );
         // The cone holds little more than the covered samples, far fewer than all.
         assert!(candidates < total / 16, "{candidates} of {total}");
     }

@@ -228,6 +228,12 @@ impl CentredEdge {
         }
     }
 
+    /// The end points relative to the centre.
+    #[inline]
+    pub fn ends(&self) -> (DVec3, DVec3) {
+        (self.a, self.b)
+    }
+
     /// The covered-sample test from the centred view sample `p`; `None` on the tie of
     /// [`EdgeTest::new`] (the edge's line meets the line from `p` to `c`).
     #[inline]

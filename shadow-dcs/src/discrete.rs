@@ -206,11 +206,71 @@ impl DiscreteTables {
         })
     }
 
-    /// Light-plane coordinates (relative to the centre) of the projection of `x` from `p`.
-    fn project(&self, p: DVec3, x: DVec3) -> DVec2 {
-        let t = (self.center - p).dot(self.normal) / (x - p).dot(self.normal);
-        let y = p + (x - p) * t - self.center;
-        DVec2::new(y.dot(self.t1), y.dot(self.t2))
+    /// The light-plane coordinates of the projections of the edge `a b` from `p` (all three
+    /// relative to the light centre), with the foot of the perpendicular from the centre to
+    /// their line; `None` where the tables cannot answer: an end point outside the slab
+    /// between `p`'s parallel plane and the light plane, or a line through (or within rounding
+    /// of) the centre.
+    fn project_edge(&self, p: DVec3, a: DVec3, b: DVec3) -> Option<Projected> {
+        let h = -p.dot(self.normal);
+        let (ha, hb) = ((a - p).dot(self.normal), (b - p).dot(self.normal));
+        // Both end points strictly between p's parallel plane and the light plane.
+        let inside = |x: f64| (h > 0.0 && x > 0.0 && x < h) || (h < 0.0 && x < 0.0 && x > h);
+        if !(inside(ha) && inside(hb)) {
+            return None;
+        }
+        let project = |x: DVec3, hx: f64| {
+            let y = p + (x - p) * (h / hx);
+            DVec2::new(y.dot(self.t1), y.dot(self.t2))
+        };
+        let (a2, b2) = (project(a, ha), project(b, hb));
+        let d = b2 - a2;
+        let cross = a2.perp_dot(b2);
+        let len = d.length();
+        if !(len > 0.0) || (cross / len).abs() < 1e-9 * self.half {
+            return None;
+        }
+        let foot = a2 - d * (a2.dot(d) / (len * len));
+        Some(Projected {
+            a: a2,
+            b: b2,
+            cross,
+            foot,
+        })
+    }
+
+    /// The first word of the line-table cell holding `foot`; `None` when the foot lies outside
+    /// the light's square, whose line leaves every sample on the centre's side (the square
+    /// holds the light's bounding circle around its centre).
+    fn cell(&self, foot: DVec2) -> Option<usize> {
+        let grid = self.grid;
+        let g = |v: f64| (((v + self.half) / (2.0 * self.half)) * grid as f64).floor();
+        let (gx, gy) = (g(foot.x), g(foot.y));
+        (gx >= 0.0 && gy >= 0.0 && gx < grid as f64 && gy < grid as f64)
+            .then(|| (gy as usize * grid + gx as usize) * self.words)
+    }
+
+    /// The sample set of a pixel.
+    fn set(&self, pixel: UVec2) -> &SetTables {
+        &self.sets[((pixel.y % self.tile) * self.tile + pixel.x % self.tile) as usize]
+    }
+
+    /// The refined tables' answer for the line of the edge `a b` seen from `p` (all three
+    /// relative to the light centre), for pixel `pixel`'s sample set.
+    pub(crate) fn refined_line(&self, pixel: UVec2, p: DVec3, a: DVec3, b: DVec3) -> LineMasks<'_> {
+        debug_assert!(self.refined);
+        let Some(pr) = self.project_edge(p, a, b) else {
+            return LineMasks::Unknown;
+        };
+        let Some(cell) = self.cell(pr.foot) else {
+            return LineMasks::NoneBeyond;
+        };
+        let set = self.set(pixel);
+        let w = self.words;
+        LineMasks::Cell {
+            beyond: &set.line[cell..cell + w],
+            maybe: &set.maybe[cell..cell + w],
+        }
     }
 
     /// The covered samples of `edge` seen from `p` (pixel `pixel`'s set), restricted to
@@ -228,32 +288,20 @@ impl DiscreteTables {
         allowed: &[u64],
         mask: &mut [u64],
     ) -> bool {
-        let h = (self.center - p).dot(self.normal);
-        let ha = (edge.a - p).dot(self.normal);
-        let hb = (edge.b - p).dot(self.normal);
-        // Both end points strictly between p's parallel plane and the light plane.
-        let inside = |x: f64| (h > 0.0 && x > 0.0 && x < h) || (h < 0.0 && x < 0.0 && x > h);
-        if !(inside(ha) && inside(hb)) {
+        let c = self.center;
+        let Some(Projected {
+            a: a2,
+            b: b2,
+            cross,
+            foot,
+        }) = self.project_edge(p - c, edge.a - c, edge.b - c)
+        else {
             return test.mask(relative, allowed, mask);
-        }
-        let (a2, b2) = (self.project(p, edge.a), self.project(p, edge.b));
-        let d = b2 - a2;
-        let cross = a2.perp_dot(b2);
-        let len = d.length();
-        if !(len > 0.0) || (cross / len).abs() < 1e-9 * self.half {
-            return test.mask(relative, allowed, mask);
-        }
-        // Foot of the perpendicular from the centre (origin) to the line.
-        let foot = a2 - d * (a2.dot(d) / (len * len));
-        let set = &self.sets[((pixel.y % self.tile) * self.tile + pixel.x % self.tile) as usize];
+        };
+        let set = self.set(pixel);
         let w = self.words;
-        let grid = self.grid;
-        let g = |v: f64| (((v + self.half) / (2.0 * self.half)) * grid as f64).floor();
-        let (gx, gy) = (g(foot.x), g(foot.y));
-        let cell = (gx >= 0.0 && gy >= 0.0 && gx < grid as f64 && gy < grid as f64)
-            .then(|| (gy as usize * grid + gx as usize) * w);
-        let line: Option<&[u64]> = cell.map(|cell| &set.line[cell..cell + w]);
-        let Some(line) = line else {
+        let cell = self.cell(foot);
+        let Some(line) = cell.map(|cell| &set.line[cell..cell + w]) else {
             // The line misses the light's square: no sample lies beyond it.
             mask.fill(0);
             return false;
@@ -306,6 +354,28 @@ impl DiscreteTables {
         }
         any != 0
     }
+}
+
+/// An edge projected from a view sample onto the light plane, in the tables' coordinates.
+struct Projected {
+    a: DVec2,
+    b: DVec2,
+    /// `a x b`: positive when `a` comes first counter-clockwise around the centre.
+    cross: f64,
+    /// The foot of the perpendicular from the centre to the line `a b`.
+    foot: DVec2,
+}
+
+/// What the refined line table says about the samples beyond an edge's projected line.
+pub(crate) enum LineMasks<'a> {
+    /// The table cannot answer (see [`DiscreteTables::mask`]): every candidate takes the
+    /// exact test.
+    Unknown,
+    /// The line leaves the light's square: no sample is beyond it.
+    NoneBeyond,
+    /// The cell of the line's foot: the samples surely beyond the line, and those not surely
+    /// before it.
+    Cell { beyond: &'a [u64], maybe: &'a [u64] },
 }
 
 /// Angle bin of a direction (counter-clockwise from the first axis).

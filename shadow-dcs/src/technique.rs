@@ -17,14 +17,16 @@
 //! whole light is 0 without samples; one in no wedge, or whose wedge edges all miss the light
 //! (the exact light-overlap test, `wedge-pairs-off-light`), takes its integration constant for
 //! every sample (fully lit or umbra, no counters); a pair whose angular sector holds no sample
-//! is dropped without a per-sample test (`wedge-pairs-empty-sector`); the texture and opacity
-//! paths run only when the light is textured or the scene semi-opaque.
+//! is dropped without a per-sample test (`wedge-pairs-empty-sector`); with the refined tables
+//! of section 7.3, a pair with many candidates looks its line up in the line table, which
+//! settles every candidate it can (`refined-line-cells`); the texture and opacity paths run only
+//! when the light is textured or the scene semi-opaque.
 //!
 //! Light samples behind the receiver's tangent plane are occluded, and view samples are offset
 //! off their surface, exactly as the reference does ([`shadow_core::offset`]), so that with the
 //! same samples the two agree sample by sample up to numerical ties.
 
-use glam::{DVec3, Vec2, Vec3};
+use glam::{DVec3, UVec2, Vec2, Vec3};
 use rayon::prelude::*;
 use serde_json::json;
 use shadow_core::direct::pixel_direct;
@@ -40,7 +42,7 @@ use crate::centred::CentredEdge;
 use crate::constant::{eye_constant, integration_constants};
 use crate::counters::{Packed, WIDTHS, width_for};
 use crate::coverage::{EdgeTest, RelativePolygon, RelativeSamples};
-use crate::discrete::{CoveredSamples, DiscreteTables};
+use crate::discrete::{CoveredSamples, DiscreteTables, LineMasks};
 use crate::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
 use crate::lanes::BAND_ROWS;
 use crate::light_shape::LightShape;
@@ -137,6 +139,16 @@ enum Horizon {
     Mixed,
 }
 
+/// What the batched covered-sample step needs of the refined tables of section 7.3 for one
+/// pixel.
+struct Refined<'a> {
+    tables: &'a DiscreteTables,
+    edges: &'a [CentredEdge],
+    /// The view sample relative to the light centre.
+    p: DVec3,
+    pixel: UVec2,
+}
+
 /// Per-thread buffers.
 #[derive(Default)]
 struct Scratch {
@@ -151,7 +163,12 @@ struct Scratch {
     /// Tests waiting for their candidates, and their weights.
     batch: Vec<EdgeTest>,
     batch_k: Vec<i64>,
+    /// The silhouette index of each waiting test's edge (for the refined line table).
+    batch_edge: Vec<u32>,
     batch_candidates: Vec<u64>,
+    /// Per waiting test, the candidates in its sector's inner buckets (refined tables only).
+    batch_inner: Vec<u64>,
+    undecided: Vec<u64>,
     masks: Vec<u64>,
     weights: Vec<i64>,
     packed: Packed,
@@ -185,6 +202,7 @@ struct Counts {
     pairs: u64,
     off_light: u64,
     sector_empty: u64,
+    line_cells: u64,
 }
 
 impl Counts {
@@ -202,6 +220,7 @@ impl Counts {
         self.pairs += o.pairs;
         self.off_light += o.off_light;
         self.sector_empty += o.sector_empty;
+        self.line_cells += o.line_cells;
     }
 }
 
@@ -462,8 +481,18 @@ impl Dcs {
         if let (Some(poly), false) = (&p.polygon, entries.is_empty()) {
             scratch.polygon.set(poly, f.centred[i]);
         }
+        // The refined tables of section 7.3 settle what they can of the index's candidates.
+        let refined = match (self.covered, &p.tables) {
+            (CoveredSamples::Refined, Some(t)) => Some(Refined {
+                tables: t,
+                edges: &p.centred_edges,
+                p: pc,
+                pixel: s.pixel,
+            }),
+            _ => None,
+        };
         let indexed = p.shape.plane.is_some()
-            && self.covered == CoveredSamples::Exact
+            && (self.covered == CoveredSamples::Exact || refined.is_some())
             && entries.len() >= INDEX_MIN_PAIRS;
         let all_above = horizon == Horizon::Above;
         let mut ready = horizon == Horizon::Mixed;
@@ -487,15 +516,18 @@ impl Dcs {
                 // Candidates a batch at a time (their sector arithmetic vectorises).
                 scratch.batch.push(test);
                 scratch.batch_k.push(pair.k as i64);
+                if refined.is_some() {
+                    scratch.batch_edge.push(pair.edge);
+                }
                 if scratch.batch.len() == BATCH {
-                    Self::indexed_updates(scratch, counts);
+                    Self::indexed_updates(scratch, counts, refined.as_ref());
                 }
             } else {
                 self.covered_update(p, s, o, pair, &test, scratch, counts);
             }
         }
         if !scratch.batch.is_empty() {
-            Self::indexed_updates(scratch, counts);
+            Self::indexed_updates(scratch, counts, refined.as_ref());
         }
         if !ready {
             // No wedge: every sample has the integration constant.
@@ -676,15 +708,18 @@ impl Dcs {
     }
 
     /// The covered samples of the batched tests (`scratch.batch`, emptied): their angular
-    /// candidates, then the exact test on those, appended to the pixel's updates when any.
-    fn indexed_updates(scratch: &mut Scratch, counts: &mut Counts) {
+    /// candidates, then the exact test on those (with `refined`, on those the line table leaves
+    /// undecided), appended to the pixel's updates when any.
+    fn indexed_updates(scratch: &mut Scratch, counts: &mut Counts, refined: Option<&Refined>) {
         let words = scratch.above.len();
         let n = scratch.batch.len();
         scratch.batch_candidates.resize(BATCH * words, 0);
+        scratch.batch_inner.resize(BATCH * words, 0);
         let any = scratch.angular.candidates_batch(
             &scratch.batch,
             &scratch.above,
             &mut scratch.batch_candidates,
+            refined.map(|_| &mut scratch.batch_inner[..]),
         );
         counts.edge_tests += n as u64;
         for (i, (test, k)) in scratch.batch.iter().zip(&scratch.batch_k).enumerate() {
@@ -694,7 +729,38 @@ impl Dcs {
             }
             let cand = &scratch.batch_candidates[i * words..(i + 1) * words];
             let mask = &mut scratch.mask;
-            let covered = if cand.iter().map(|w| w.count_ones()).sum::<u32>() <= FEW_CANDIDATES {
+            let few = cand.iter().map(|w| w.count_ones()).sum::<u32>() <= FEW_CANDIDATES;
+            if let (Some(r), false) = (refined, few) {
+                // Candidates in the sector's inner buckets and surely beyond the line are
+                // covered; the exact test takes those the line leaves undecided.
+                let (a, b) = r.edges[scratch.batch_edge[i] as usize].ends();
+                match r.tables.refined_line(r.pixel, r.p, a, b) {
+                    LineMasks::Unknown => {}
+                    LineMasks::NoneBeyond => continue,
+                    LineMasks::Cell { beyond, maybe } => {
+                        counts.line_cells += 1;
+                        let inner = &scratch.batch_inner[i * words..(i + 1) * words];
+                        let undecided = &mut scratch.undecided;
+                        undecided.clear();
+                        let mut open = 0;
+                        for j in 0..words {
+                            mask[j] = inner[j] & beyond[j];
+                            undecided.push(cand[j] & maybe[j] & !mask[j]);
+                            open |= undecided[j];
+                        }
+                        if open != 0 {
+                            test.add_covered(&scratch.relative, undecided, mask);
+                        }
+                        if mask.iter().any(|w| *w != 0) {
+                            counts.covered_updates += 1;
+                            scratch.masks.extend_from_slice(mask);
+                            scratch.weights.push(*k);
+                        }
+                        continue;
+                    }
+                }
+            }
+            let covered = if few {
                 mask.fill(0);
                 test.add_covered(&scratch.relative, cand, mask);
                 mask.iter().any(|w| *w != 0)
@@ -709,6 +775,7 @@ impl Dcs {
         }
         scratch.batch.clear();
         scratch.batch_k.clear();
+        scratch.batch_edge.clear();
     }
 
     /// Direct illumination of every view sample by DCS eq. 6: the light samples' contributions
@@ -1037,6 +1104,7 @@ impl ShadowTechnique for Dcs {
         stats.add("wedge-pairs", counts.pairs);
         stats.add("wedge-pairs-off-light", counts.off_light);
         stats.add("wedge-pairs-empty-sector", counts.sector_empty);
+        stats.add("refined-line-cells", counts.line_cells);
         vis.validate()?;
         Ok(Estimate {
             visibility: vis,
