@@ -3,8 +3,12 @@
 //!
 //! For each sample set, in the light plane around the centre `c`:
 //! * a **sector table** over `ANGLE_BINS` directions: bit `i` of entry `k` is set when sample
-//!   `i` lies at an angle (from the light's first axis, counter-clockwise) below the start of
-//!   bin `k + 1` (the paper's cube map of "samples from the origin to `v`");
+//!   `i` lies at a direction (counter-clockwise from the light's first axis) below the start of
+//!   bin `k + 1` (the paper's cube map of "samples from the origin to `v`"). Like the cube
+//!   map's texels, the bins are uniform in a pseudo-angle rather than in the angle: the
+//!   "diamond angle" `1 - x / (|x| + |y|)` (`3 + x / (|x| + |y|)` below the axis), monotone
+//!   in the angle, each bin at most `4 / pi` (1.27) times as wide as a uniform one, and free of
+//!   the two `atan2` per edge that uniform bins cost;
 //! * a **line table** over a `LINE_GRID x LINE_GRID` grid of the light's square: for the cell
 //!   holding the foot `q` of the perpendicular from `c` to a line, the samples beyond the line
 //!   (`s . q / |q| > |q|`), evaluated at the cell centre (the paper's 2D texture).
@@ -15,8 +19,6 @@
 //! bin's resolution, which is the representation's error; the exact mode
 //! (`coverage::EdgeTest`) has none. Three lookups and two bit operations replace a loop
 //! over the samples.
-
-use std::f64::consts::TAU;
 
 use glam::{DVec2, DVec3, UVec2};
 use shadow_core::light::{AreaLight, LightGeometry};
@@ -43,7 +45,14 @@ pub enum CoveredSamples {
     /// The same tables, holding for each line cell the samples surely beyond and surely before
     /// every line whose foot lies in the cell: the tables classify every sample they can decide,
     /// and only the samples in the end points' angle bins or in an undecided line cell take the
-    /// exact test. Exact like [`CoveredSamples::Exact`], at close to table cost.
+    /// exact test. Exact like [`CoveredSamples::Exact`].
+    ///
+    /// In a pixel with at least 6 wedge pairs the sector part comes from the pixel's angular
+    /// index (the sector table of its own samples, `crate::angular`): a pair whose sector holds
+    /// at most 12 candidates tests them exactly, one with more looks its line up in the line
+    /// table, which settles the candidates in the sector's inner buckets surely beyond the line
+    /// and drops those surely before it. On `bunny` at 512x512 this runs in 0.23 s against
+    /// 0.36 s when every pair looked both tables up (`docs/benchmarks.md`).
     Refined,
 }
 
@@ -378,10 +387,17 @@ pub(crate) enum LineMasks<'a> {
     Cell { beyond: &'a [u64], maybe: &'a [u64] },
 }
 
-/// Angle bin of a direction (counter-clockwise from the first axis).
+/// Angle bin of a direction (counter-clockwise from the first axis), uniform in the diamond
+/// angle in `[0, 4)` (the double-precision form of the angular index's pseudo-angle); the
+/// zero vector falls in bin 0.
 fn angle_bin(v: DVec2) -> usize {
-    let a = v.y.atan2(v.x).rem_euclid(TAU);
-    ((a / TAU * ANGLE_BINS as f64) as usize).min(ANGLE_BINS - 1)
+    let r = v.x.abs() + v.y.abs();
+    if !(r > 0.0) {
+        return 0;
+    }
+    let t = v.x / r;
+    let a = if v.y >= 0.0 { 1.0 - t } else { 3.0 + t };
+    ((a / 4.0 * ANGLE_BINS as f64) as usize).min(ANGLE_BINS - 1)
 }
 
 #[cfg(test)]
