@@ -330,7 +330,14 @@ impl DiscreteTables {
                 }
             };
             // upto(k): samples in bins below k.
-            let mut uncertain = vec![0u64; w];
+            // Up to 1024 samples on the stack; more on the heap.
+            let (mut stack, mut heap) = ([0u64; 16], Vec::new());
+            let uncertain: &mut [u64] = if w <= stack.len() {
+                &mut stack[..w]
+            } else {
+                heap.resize(w, 0);
+                &mut heap
+            };
             let mut any_uncertain = 0u64;
             for j in 0..w {
                 let inner = if k0 < k1 {
@@ -347,7 +354,7 @@ impl DiscreteTables {
                 any_uncertain |= uncertain[j];
             }
             if any_uncertain != 0 {
-                test.add_covered(relative, &uncertain, mask);
+                test.add_covered(relative, uncertain, mask);
             }
             return mask.iter().any(|m| *m != 0);
         }
