@@ -730,42 +730,43 @@ impl Dcs {
             let cand = &scratch.batch_candidates[i * words..(i + 1) * words];
             let mask = &mut scratch.mask;
             let few = cand.iter().map(|w| w.count_ones()).sum::<u32>() <= FEW_CANDIDATES;
-            if let (Some(r), false) = (refined, few) {
-                // Candidates in the sector's inner buckets and surely beyond the line are
-                // covered; the exact test takes those the line leaves undecided.
-                let (a, b) = r.edges[scratch.batch_edge[i] as usize].ends();
-                match r.tables.refined_line(r.pixel, r.p, a, b) {
-                    LineMasks::Unknown => {}
-                    LineMasks::NoneBeyond => continue,
-                    LineMasks::Cell { beyond, maybe } => {
-                        counts.line_cells += 1;
-                        let inner = &scratch.batch_inner[i * words..(i + 1) * words];
-                        let undecided = &mut scratch.undecided;
-                        undecided.clear();
-                        let mut open = 0;
-                        for j in 0..words {
-                            mask[j] = inner[j] & beyond[j];
-                            undecided.push(cand[j] & maybe[j] & !mask[j]);
-                            open |= undecided[j];
+            // With the refined tables, a pair with many candidates asks the line table first:
+            // candidates in the sector's inner buckets and surely beyond the line are covered,
+            // the exact test takes those the line leaves undecided.
+            let decided = match (refined, few) {
+                (Some(r), false) => {
+                    let (a, b) = r.edges[scratch.batch_edge[i] as usize].ends();
+                    match r.tables.refined_line(r.pixel, r.p, a, b) {
+                        LineMasks::Unknown => None,
+                        LineMasks::NoneBeyond => Some(false),
+                        LineMasks::Cell { beyond, maybe } => {
+                            counts.line_cells += 1;
+                            let inner = &scratch.batch_inner[i * words..(i + 1) * words];
+                            let undecided = &mut scratch.undecided;
+                            undecided.clear();
+                            let mut open = 0;
+                            for j in 0..words {
+                                mask[j] = inner[j] & beyond[j];
+                                undecided.push(cand[j] & maybe[j] & !mask[j]);
+                                open |= undecided[j];
+                            }
+                            if open != 0 {
+                                test.add_covered(&scratch.relative, undecided, mask);
+                            }
+                            Some(mask.iter().any(|w| *w != 0))
                         }
-                        if open != 0 {
-                            test.add_covered(&scratch.relative, undecided, mask);
-                        }
-                        if mask.iter().any(|w| *w != 0) {
-                            counts.covered_updates += 1;
-                            scratch.masks.extend_from_slice(mask);
-                            scratch.weights.push(*k);
-                        }
-                        continue;
                     }
                 }
-            }
-            let covered = if few {
-                mask.fill(0);
-                test.add_covered(&scratch.relative, cand, mask);
-                mask.iter().any(|w| *w != 0)
-            } else {
-                test.mask(&scratch.relative, cand, mask)
+                _ => None,
+            };
+            let covered = match decided {
+                Some(covered) => covered,
+                None if few => {
+                    mask.fill(0);
+                    test.add_covered(&scratch.relative, cand, mask);
+                    mask.iter().any(|w| *w != 0)
+                }
+                None => test.mask(&scratch.relative, cand, mask),
             };
             if covered {
                 counts.covered_updates += 1;
