@@ -14,10 +14,11 @@
 //! ([`AngularIndex::candidates_batch`]): each step of the sectors' arithmetic is a loop over
 //! the batch, which the compiler turns into packed instructions.
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 
 use crate::coverage::EdgeTest;
 use crate::light_shape::LightPlane;
+use crate::planar::{PlanarSamples, PlanarTest};
 
 /// Angular buckets over a whole turn.
 pub(crate) const BUCKETS: usize = 256;
@@ -64,19 +65,37 @@ fn bucket(a: f32) -> usize {
 impl AngularIndex {
     /// Indexes the sample `positions` of a pixel on the light `plane` with centre `c`.
     pub fn build(&mut self, plane: &LightPlane, c: Vec3, positions: &[Vec3]) {
-        let words = positions.len().div_ceil(64);
-        self.words = words;
         self.u = plane.u;
         self.v = plane.v;
-        self.prefix.clear();
-        self.prefix.resize((BUCKETS + 1) * words, 0);
-        // Bucket contents first (in entry j + 1), then the running union. The buckets are
-        // computed sample by sample in one loop (which vectorises), then scattered.
+        // The buckets are computed sample by sample in one loop (which vectorises), then
+        // scattered.
         self.buckets.clear();
         self.buckets.extend(positions.iter().map(|s| {
             let d = *s - c;
             bucket(direction_angle(d.dot(plane.u), d.dot(plane.v))) as u32
         }));
+        self.index_buckets(positions.len());
+    }
+
+    /// Indexes a pixel's samples given in the light plane around the centre (the first `n` of
+    /// `samples`).
+    pub fn build_planar(&mut self, samples: &PlanarSamples, n: usize) {
+        self.buckets.clear();
+        self.buckets.extend(
+            samples.x[..n]
+                .iter()
+                .zip(&samples.y[..n])
+                .map(|(x, y)| bucket(direction_angle(*x, *y)) as u32),
+        );
+        self.index_buckets(n);
+    }
+
+    /// The prefix masks from `self.buckets` (the first `n` samples' buckets).
+    fn index_buckets(&mut self, n: usize) {
+        let words = n.div_ceil(64);
+        self.words = words;
+        self.prefix.clear();
+        self.prefix.resize((BUCKETS + 1) * words, 0);
         for (k, b) in self.buckets.iter().enumerate() {
             self.prefix[(*b as usize + 1) * words + k / 64] |= 1 << (k % 64);
         }
@@ -94,6 +113,34 @@ impl AngularIndex {
                 }
             }
         }
+    }
+
+    /// The samples of `allowed` that may lie in sector `j` of `r` (every sample the exact
+    /// test covers is among them), into `out`; returns whether there is any.
+    #[inline]
+    pub fn quad_candidates(
+        &self,
+        r: &QuadRanges,
+        j: usize,
+        allowed: &[u64],
+        out: &mut [u64],
+    ) -> bool {
+        if r.narrow >> j & 1 == 0 {
+            out.copy_from_slice(allowed);
+            return allowed.iter().any(|x| *x != 0);
+        }
+        let wraps = r.wraps >> j & 1 == 1;
+        if let ([o], [a]) = (&mut *out, allowed) {
+            let (below_lo, upto_hi) = (self.prefix[r.lo[j]], self.prefix[r.hi[j] + 1]);
+            let range = if wraps {
+                upto_hi | !below_lo
+            } else {
+                upto_hi & !below_lo
+            };
+            *o = range & a;
+            return *o != 0;
+        }
+        self.buckets_into(r.lo[j] as u32, r.hi[j] as u32, wraps, allowed, out)
     }
 
     /// Writes to `out` the samples of `allowed` that may lie in the sector of `test` (every
@@ -121,7 +168,7 @@ impl AngularIndex {
         mut inner: Option<&mut [u64]>,
     ) -> u32 {
         debug_assert!(tests.len() <= BATCH);
-        let sectors = Normals::of(tests).sectors(self.u, self.v, inner.is_some());
+        let sectors = Normals::of(tests, self.u, self.v).sectors(inner.is_some());
         let w = self.words;
         let mut any = 0u32;
         for (i, s) in sectors.iter().take(tests.len()).enumerate() {
@@ -188,6 +235,76 @@ impl AngularIndex {
     }
 }
 
+/// The bucket ranges of four light-plane sectors (the cone `a . d > 0`, `b . d < 0`), computed
+/// as in `Normals::sectors`, four lanes at a time.
+pub(crate) struct QuadRanges {
+    lo: [usize; 4],
+    hi: [usize; 4],
+    /// Lanes whose sector the index can narrow.
+    narrow: u32,
+    /// Lanes whose range runs round past the last bucket.
+    wraps: u32,
+}
+
+impl QuadRanges {
+    /// The ranges of four light-plane tests' sectors.
+    #[inline]
+    pub fn of_tests(tests: &[PlanarTest; 4]) -> Self {
+        let sides = tests.map(|t| t.sector());
+        Self::of(
+            Vec4::from_array(sides.map(|s| s.0.x)),
+            Vec4::from_array(sides.map(|s| s.0.y)),
+            Vec4::from_array(sides.map(|s| s.1.x)),
+            Vec4::from_array(sides.map(|s| s.1.y)),
+        )
+    }
+
+    /// The ranges of the cones `a . d > 0`, `b . d < 0` given lane by lane.
+    #[inline(always)]
+    fn of(ax: Vec4, ay: Vec4, bx: Vec4, by: Vec4) -> Self {
+        let zero = Vec4::ZERO;
+        let turn = Vec4::splat(TURN);
+        let angle = |x: Vec4, y: Vec4| -> Vec4 {
+            let t = x / (x.abs() + y.abs());
+            let a = Vec4::select(y.cmpge(zero), Vec4::ONE - t, Vec4::splat(3.0) + t);
+            // Zero vector (NaN) and the rounding to 4 just below +x both map to 0.
+            Vec4::select(a.cmpge(zero) & a.cmplt(turn), a, zero)
+        };
+        let la2 = ax * ax + ay * ay;
+        let lb2 = bx * bx + by * by;
+        let cross = ax * by - ay * bx;
+        let sign = Vec4::select(cross.cmpgt(zero), Vec4::ONE, -Vec4::ONE);
+        let ta = angle(ay * sign, -ax * sign);
+        let tb = angle(by * sign, -bx * sign);
+        let d = tb - ta;
+        let ccw = Vec4::select(tb.cmpge(ta), d, d + turn);
+        let half = ccw.cmple(Vec4::splat(TURN / 2.0));
+        let start = Vec4::select(half, ta, tb);
+        let arc = Vec4::select(half, ccw, turn - ccw);
+        let lo = start - Vec4::splat(MARGIN);
+        let len = arc + Vec4::splat(2.0 * MARGIN);
+        let lo = Vec4::select(lo.cmplt(zero), lo + turn, lo);
+        let h = lo + len;
+        let hi = Vec4::select(h.cmpge(turn), h - turn, h);
+        let narrow = la2.cmpgt(zero)
+            & lb2.cmpgt(zero)
+            & (cross * cross).cmpgt(Vec4::splat(1e-6) * la2 * lb2)
+            & len.cmplt(Vec4::splat(TURN / 2.0));
+        let scale = Vec4::splat(BUCKETS as f32 / TURN);
+        let to_bucket = |a: Vec4| -> [usize; 4] {
+            (a * scale)
+                .to_array()
+                .map(|x| (x as i32).clamp(0, BUCKETS as i32 - 1) as usize)
+        };
+        Self {
+            lo: to_bucket(lo),
+            hi: to_bucket(hi),
+            narrow: narrow.bitmask(),
+            wraps: lo.cmpgt(hi).bitmask(),
+        }
+    }
+}
+
 /// Tests per [`AngularIndex::candidates_batch`].
 pub(crate) const BATCH: usize = 8;
 
@@ -206,25 +323,35 @@ struct Sector {
     inner: Option<(u32, u32)>,
 }
 
-/// The sector normals of a batch of tests, structure of arrays.
+/// The sector normals of a batch of tests in the light plane, with the squared lengths of the
+/// normals they come from, structure of arrays.
 struct Normals {
-    a: [[f32; BATCH]; 3],
-    b: [[f32; BATCH]; 3],
+    ax: [f32; BATCH],
+    ay: [f32; BATCH],
+    bx: [f32; BATCH],
+    by: [f32; BATCH],
+    ga2: [f32; BATCH],
+    gb2: [f32; BATCH],
 }
 
 impl Normals {
-    /// The sector normals of up to [`BATCH`] tests (unused lanes zero).
-    fn of(tests: &[EdgeTest]) -> Self {
-        let mut n = Normals {
-            a: [[0.0; BATCH]; 3],
-            b: [[0.0; BATCH]; 3],
-        };
+    const ZERO: Self = Self {
+        ax: [0.0; BATCH],
+        ay: [0.0; BATCH],
+        bx: [0.0; BATCH],
+        by: [0.0; BATCH],
+        ga2: [0.0; BATCH],
+        gb2: [0.0; BATCH],
+    };
+
+    /// The sector normals of up to [`BATCH`] tests in the plane of axes `u`, `v` (unused
+    /// lanes zero).
+    fn of(tests: &[EdgeTest], u: Vec3, v: Vec3) -> Self {
+        let mut n = Self::ZERO;
         for (i, t) in tests.iter().enumerate().take(BATCH) {
             let (ga, gb) = t.sector_normals();
-            for k in 0..3 {
-                n.a[k][i] = ga[k];
-                n.b[k][i] = gb[k];
-            }
+            (n.ax[i], n.ay[i], n.ga2[i]) = (ga.dot(u), ga.dot(v), ga.length_squared());
+            (n.bx[i], n.by[i], n.gb2[i]) = (gb.dot(u), gb.dot(v), gb.length_squared());
         }
         n
     }
@@ -233,17 +360,12 @@ impl Normals {
 impl Normals {
     /// The bucket ranges of the batch's sectors, each step lane by lane over the batch (loops
     /// the compiler vectorises), branch-free; their inner buckets only `with_inner`.
-    fn sectors(&self, u: Vec3, v: Vec3, with_inner: bool) -> [Sector; BATCH] {
+    fn sectors(&self, with_inner: bool) -> [Sector; BATCH] {
         type Lanes = [f32; BATCH];
         let lanes = |f: &dyn Fn(usize) -> f32| -> Lanes { std::array::from_fn(f) };
-        let dot =
-            |g: &[Lanes; 3], w: Vec3| lanes(&|i| g[0][i] * w.x + g[1][i] * w.y + g[2][i] * w.z);
-        let len2 =
-            |g: &[Lanes; 3]| lanes(&|i| g[0][i] * g[0][i] + g[1][i] * g[1][i] + g[2][i] * g[2][i]);
         // In the light plane, the cone is A . d > 0 and B . d < 0 for d = s - c.
-        let (ax, ay) = (dot(&self.a, u), dot(&self.a, v));
-        let (bx, by) = (dot(&self.b, u), dot(&self.b, v));
-        let (ga2, gb2) = (len2(&self.a), len2(&self.b));
+        let (ax, ay, bx, by) = (&self.ax, &self.ay, &self.bx, &self.by);
+        let (ga2, gb2) = (&self.ga2, &self.gb2);
         let la2 = lanes(&|i| ax[i] * ax[i] + ay[i] * ay[i]);
         let lb2 = lanes(&|i| bx[i] * bx[i] + by[i] * by[i]);
         let cross = lanes(&|i| ax[i] * by[i] - ay[i] * bx[i]);

@@ -14,11 +14,11 @@
 //!   orientation `orient(a, b, p, c) = (p' x e) . a'` (in double precision, like
 //!   [`EdgeTest::new`], whose tie rule it keeps).
 
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec3, Vec4};
 
 use crate::coverage::EdgeTest;
 use crate::edges::SceneEdge;
-use crate::lanes::{LANES, LaneMask, Lanes, TileLanes, above_bound, non_negative};
+use crate::lanes::{LANES, LaneMask, TileQuads, lanes_of};
 
 /// Relative error bound of an `f32` plane evaluation, against `|n|_1 |x'|_1 + |d|`. The value
 /// carries the rounding of `n` and `d` to `f32` (one unit in the last place, `6e-8`, each), of
@@ -55,56 +55,51 @@ impl CentredPlane {
         }
     }
 
-    /// The value at the centred point `x`.
+    /// The normal and offset (`n . x' + d`).
     #[inline]
-    pub fn eval(&self, x: Vec3) -> f32 {
-        self.n.dot(x) + self.d
+    pub fn coefficients(&self) -> (Vec3, f32) {
+        (self.n, self.d)
     }
 
-    /// The values at every lane of a tile (the order of operations of [`Self::eval`]).
-    #[inline]
-    pub fn eval_lanes(&self, t: &TileLanes, out: &mut Lanes) {
-        for j in 0..LANES {
-            out[j] = self.n.x * t.x[j] + self.n.y * t.y[j] + self.n.z * t.z[j] + self.d;
+    /// The values at the four lane quads of a tile.
+    #[inline(always)]
+    fn eval_quads(&self, t: &TileQuads) -> [Vec4; 4] {
+        let (nx, ny, nz, d) = (
+            Vec4::splat(self.n.x),
+            Vec4::splat(self.n.y),
+            Vec4::splat(self.n.z),
+            Vec4::splat(self.d),
+        );
+        std::array::from_fn(|q| nx * t.x[q] + ny * t.y[q] + nz * t.z[q] + d)
+    }
+
+    /// The lanes of `lanes` whose magnitude of `v` exceeds this plane's error bound there (a
+    /// certain sign; NaN fails).
+    #[inline(always)]
+    fn certain_quads(&self, t: &TileQuads, v: &[Vec4; 4]) -> LaneMask {
+        let (bn, bd) = (Vec4::splat(self.bound_n), Vec4::splat(self.bound_d));
+        let mut m = 0;
+        for q in 0..4 {
+            m |= (v[q].abs().cmpgt(bn * t.l1[q] + bd).bitmask() as LaneMask) << (4 * q);
         }
+        m
     }
 
-    /// The lanes of a tile that no plane of `planes` puts on its negative side (a NaN value
-    /// rejects nothing, as in a scalar `eval(x) < 0` test).
+    /// The lanes of `lanes` that no plane of `planes` puts on its negative side (a NaN value
+    /// rejects nothing, as in a scalar `eval(x) < 0` test); stops when no lane is left.
     #[inline]
-    pub fn inside_all(planes: &[Self], t: &TileLanes) -> LaneMask {
-        let mut low = [f32::INFINITY; LANES];
-        let mut v = [0.0f32; LANES];
+    pub fn inside_all(planes: &[Self], t: &TileQuads, lanes: LaneMask) -> LaneMask {
+        let mut alive = lanes;
         for p in planes {
-            p.eval_lanes(t, &mut v);
-            for j in 0..LANES {
-                low[j] = low[j].min(v[j]);
+            if alive == 0 {
+                break;
+            }
+            let v = p.eval_quads(t);
+            for q in 0..4 {
+                alive &= !((v[q].cmplt(Vec4::ZERO).bitmask() as LaneMask) << (4 * q));
             }
         }
-        non_negative(&low)
-    }
-
-    /// The error bounds of [`Self::eval_lanes`] at every lane: a value whose magnitude exceeds
-    /// its bound has a certain sign.
-    #[inline]
-    fn bound_lanes(&self, t: &TileLanes, out: &mut Lanes) {
-        for j in 0..LANES {
-            out[j] = self.bound_n * t.l1[j] + self.bound_d;
-        }
-    }
-
-    /// The largest value over the box `lo..hi`.
-    #[inline]
-    pub fn max_over(&self, lo: Vec3, hi: Vec3) -> f32 {
-        let x = Vec3::select(self.n.cmpgt(Vec3::ZERO), hi, lo);
-        self.eval(x)
-    }
-
-    /// The smallest value over the box `lo..hi`.
-    #[inline]
-    pub fn min_over(&self, lo: Vec3, hi: Vec3) -> f32 {
-        let x = Vec3::select(self.n.cmpgt(Vec3::ZERO), lo, hi);
-        self.eval(x)
+        alive
     }
 }
 
@@ -155,9 +150,9 @@ impl FastWeight {
     }
 }
 
-/// `k_e` at every lane of a tile, with the mask of lanes whose signs are all certain; lanes
-/// outside it must take the exact weight. Face weights are at most [`LANE_WEIGHT_MAX`], so
-/// that a lane's sum cannot overflow.
+/// `k_e` at the requested lanes of a tile, with the mask of those lanes whose signs are all
+/// certain; lanes outside it must take the exact weight. Face weights are at most
+/// [`LANE_WEIGHT_MAX`], so that a lane's sum cannot overflow.
 pub(crate) struct LaneWeights {
     pub k: [i32; LANES],
     pub certain: LaneMask,
@@ -166,36 +161,51 @@ pub(crate) struct LaneWeights {
 /// The largest face weight the lane form takes (larger ones go through the exact weight).
 const LANE_WEIGHT_MAX: i64 = 1 << 29;
 
+/// The mask of lanes where a lane quad comparison holds.
+#[inline(always)]
+fn mask_of(v: &[Vec4; 4], f: impl Fn(Vec4) -> glam::BVec4A) -> LaneMask {
+    let mut m = 0;
+    for q in 0..4 {
+        m |= (f(v[q]).bitmask() as LaneMask) << (4 * q);
+    }
+    m
+}
+
 impl FastWeight {
-    /// `k_e` at every lane of a tile by the rule of [`SceneEdge::sweep_weight`] from a view
-    /// sample toward `c`: that rule's side of `c` is the sign of `-N_c . (x - a)` and a face's
-    /// side that of `-N_f . (x - a)`; a one-sided face counts only from behind. `None` when a
-    /// face weight exceeds [`LANE_WEIGHT_MAX`].
+    /// `k_e` at the lanes `lanes` of a tile by the rule of [`SceneEdge::sweep_weight`] from a
+    /// view sample toward `c`: that rule's side of `c` is the sign of `-N_c . (x - a)` and a
+    /// face's side that of `-N_f . (x - a)`; a one-sided face counts only from behind. `None`
+    /// when a face weight exceeds [`LANE_WEIGHT_MAX`].
     #[inline]
-    pub fn weight_lanes(&self, t: &TileLanes) -> Option<LaneWeights> {
-        let (mut v, mut bound) = ([0.0f32; LANES], [0.0f32; LANES]);
-        self.through_center.eval_lanes(t, &mut v);
-        self.through_center.bound_lanes(t, &mut bound);
-        let mut certain = above_bound(&v, &bound);
-        let from_negative = v;
-        let mut k = [0i32; LANES];
-        for f in self.faces.iter().flatten() {
+    pub fn weight_lanes(&self, t: &TileQuads, lanes: LaneMask) -> Option<LaneWeights> {
+        let v = self.through_center.eval_quads(t);
+        let mut certain = self.through_center.certain_quads(t, &v) & lanes;
+        let from_negative = mask_of(&v, |x| x.cmplt(Vec4::ZERO));
+        // Per face: the lanes where it counts and where the sweep moves onto its side.
+        let mut faces = [(0 as LaneMask, 0 as LaneMask, 0i32); 2];
+        for (slot, f) in faces.iter_mut().zip(self.faces.iter().flatten()) {
             if f.weight > LANE_WEIGHT_MAX {
                 return None;
             }
-            let w = f.weight as i32;
-            f.plane.eval_lanes(t, &mut v);
-            f.plane.bound_lanes(t, &mut bound);
-            certain &= above_bound(&v, &bound);
-            for j in 0..LANES {
-                let front = (v[j] > 0.0) == f.front_positive;
-                let counts = f.two_sided || !front;
-                let s = if (v[j] < 0.0) == (from_negative[j] < 0.0) {
-                    -w
-                } else {
-                    w
-                };
-                k[j] += if counts { s } else { 0 };
+            let v = f.plane.eval_quads(t);
+            certain &= f.plane.certain_quads(t, &v);
+            let positive = mask_of(&v, |x| x.cmpgt(Vec4::ZERO));
+            let negative = mask_of(&v, |x| x.cmplt(Vec4::ZERO));
+            let front = if f.front_positive {
+                positive
+            } else {
+                !positive
+            };
+            let counts = if f.two_sided { LaneMask::MAX } else { !front };
+            let same = !(negative ^ from_negative);
+            *slot = (counts, same, f.weight as i32);
+        }
+        let mut k = [0i32; LANES];
+        for j in lanes_of(lanes) {
+            for &(counts, same, w) in &faces {
+                if counts >> j & 1 == 1 {
+                    k[j] += if same >> j & 1 == 1 { -w } else { w };
+                }
             }
         }
         Some(LaneWeights { k, certain })
@@ -234,6 +244,14 @@ impl CentredEdge {
         (self.a, self.b)
     }
 
+    /// Whether `orient(a, b, p, c)` is positive from the centred view sample `p` (the covered
+    /// cone's orientation); `None` on the tie of [`EdgeTest::new`].
+    #[inline]
+    pub fn orientation(&self, p: DVec3) -> Option<bool> {
+        let k0 = p.cross(self.e).dot(self.a);
+        (k0 != 0.0 && k0.is_finite()).then_some(k0 > 0.0)
+    }
+
     /// The covered-sample test from the centred view sample `p`; `None` on the tie of
     /// [`EdgeTest::new`] (the edge's line meets the line from `p` to `c`).
     #[inline]
@@ -261,7 +279,7 @@ impl CentredEdge {
 mod tests {
     use super::*;
     use crate::edges::EdgeFace;
-    use crate::lanes::{BAND_ROWS, TILE_W, band_lanes};
+    use crate::lanes::{TILE_H, TILE_W, TileLanes, rect_lanes};
     use shadow_core::sampling::{hash_words, unit_float};
 
     fn face(a: DVec3, b: DVec3, third: DVec3, flip: bool, two_sided: bool) -> EdgeFace {
@@ -321,10 +339,19 @@ mod tests {
                 })
                 .collect();
             let centred: Vec<Vec3> = points.iter().map(|p| (*p - c).as_vec3()).collect();
-            let tile = band_lanes(TILE_W, (0, BAND_ROWS - 1), &centred, &[true; LANES])[0];
+            let mut tiles = Vec::new();
+            rect_lanes(
+                TILE_W,
+                (0, TILE_W - 1),
+                (0, TILE_H - 1),
+                &centred,
+                &[true; LANES],
+                &mut tiles,
+            );
+            let tile = tiles[0];
             let lanes = FastWeight::new(&edge, c)
                 .unwrap()
-                .weight_lanes(&tile)
+                .weight_lanes(&tile.quads(), tile.active)
                 .unwrap();
             for (j, p) in points.iter().enumerate() {
                 total += 1;
@@ -355,7 +382,7 @@ mod tests {
             let pc = (p - c).as_vec3();
             let fast = FastWeight::new(&edge, c).unwrap();
             total += 1;
-            let lanes = fast.weight_lanes(&TileLanes::at(pc)).unwrap();
+            let lanes = fast.weight_lanes(&TileLanes::at(pc).quads(), 1).unwrap();
             if lanes.certain & 1 == 1 {
                 answered += 1;
                 let k = i64::from(lanes.k[0]);

@@ -1,20 +1,28 @@
 //! The wedge scan (DCS section 4.2) over tiles of view samples in structure-of-arrays form:
-//! each tile of [`TILE_W`] columns by [`BAND_ROWS`] rows holds its light-centred view samples
+//! each tile of [`TILE_W`] columns by [`TILE_H`] rows holds its light-centred view samples
 //! as [`LANES`] lanes per coordinate, so that a wedge's plane tests and the signs that decide
 //! its weight run on every view sample of the tile at once (the compiler turns the lane loops
 //! into vector instructions), as a GPU evaluates a wedge's pixels in parallel.
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 
 /// Columns of a tile.
 pub(crate) const TILE_W: u32 = 4;
 
-/// Rows of a band (and of a tile): wedge pairs exist for one band at a time, which bounds their
-/// memory on scenes of very high depth complexity (`grass`).
-pub(crate) const BAND_ROWS: u32 = 4;
+/// The lanes of a tile as four packed quads per coordinate (lanes `4 q .. 4 q + 4` in quad `q`).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct TileQuads {
+    pub x: [Vec4; 4],
+    pub y: [Vec4; 4],
+    pub z: [Vec4; 4],
+    pub l1: [Vec4; 4],
+}
+
+/// Rows of a tile.
+pub(crate) const TILE_H: u32 = 4;
 
 /// View samples per tile; lane `j` is column `j % TILE_W`, row `j / TILE_W` of the tile.
-pub(crate) const LANES: usize = (TILE_W * BAND_ROWS) as usize;
+pub(crate) const LANES: usize = (TILE_W * TILE_H) as usize;
 
 /// One value per lane.
 pub(crate) type Lanes = [f32; LANES];
@@ -54,6 +62,21 @@ impl TileLanes {
         t
     }
 
+    /// The lanes as packed quads.
+    #[inline]
+    pub fn quads(&self) -> TileQuads {
+        let q = |a: &Lanes| -> [Vec4; 4] {
+            let (c, _) = a.as_chunks::<4>();
+            [c[0], c[1], c[2], c[3]].map(Vec4::from)
+        };
+        TileQuads {
+            x: q(&self.x),
+            y: q(&self.y),
+            z: q(&self.z),
+            l1: q(&self.l1),
+        }
+    }
+
     /// The box of the active view samples, `None` when there is none.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         let mut b: Option<(Vec3, Vec3)> = None;
@@ -70,64 +93,41 @@ impl TileLanes {
     }
 }
 
-/// The tiles of the band of rows `rows` (at most [`BAND_ROWS`]) of an image `width` wide, from
-/// the light-centred view samples and their activity.
-pub(crate) fn band_lanes(
+/// The tiles of the pixels in columns `cols` and rows `rows` (both starting at a multiple of
+/// the tile's side) of an image `width` wide, tile row by tile row, from the light-centred view
+/// samples and their activity, into `out`; returns the number of tiles per row.
+pub(crate) fn rect_lanes(
     width: u32,
+    cols: (u32, u32),
     rows: (u32, u32),
     centred: &[Vec3],
     active: &[bool],
-) -> Vec<TileLanes> {
-    debug_assert!(rows.1 - rows.0 < BAND_ROWS);
+    out: &mut Vec<TileLanes>,
+) -> usize {
+    debug_assert!(cols.0.is_multiple_of(TILE_W) && rows.0.is_multiple_of(TILE_H));
     let w = width as usize;
-    let mut out = vec![TileLanes::EMPTY; width.div_ceil(TILE_W) as usize];
+    let across = (cols.1 - cols.0 + 1).div_ceil(TILE_W) as usize;
+    let down = (rows.1 - rows.0 + 1).div_ceil(TILE_H) as usize;
+    out.clear();
+    out.resize(across * down, TileLanes::EMPTY);
     for y in rows.0..=rows.1 {
-        let row = (y - rows.0) as usize * TILE_W as usize;
-        for x in 0..w {
+        let yl = (y - rows.0) as usize;
+        let (tile_row, row) = (yl / TILE_H as usize, yl % TILE_H as usize);
+        for x in cols.0 as usize..=cols.1 as usize {
             let i = y as usize * w + x;
             if !active[i] {
                 continue;
             }
-            let t = &mut out[x / TILE_W as usize];
-            let j = row + x % TILE_W as usize;
+            let xl = x - cols.0 as usize;
+            let t = &mut out[tile_row * across + xl / TILE_W as usize];
+            let j = row * TILE_W as usize + xl % TILE_W as usize;
             let p = centred[i];
             (t.x[j], t.y[j], t.z[j]) = (p.x, p.y, p.z);
             t.l1[j] = p.abs().element_sum();
             t.active |= 1 << j;
         }
     }
-    out
-}
-
-/// The lanes of columns `c0..=c1` (tile-relative, clamped to the tile) and rows `r0..=r1`.
-#[inline]
-pub(crate) fn span_mask(c0: u32, c1: u32, r0: u32, r1: u32) -> LaneMask {
-    let cols = (((1u32 << (c1 - c0 + 1)) - 1) << c0) as LaneMask;
-    let mut m = 0;
-    for r in r0..=r1 {
-        m |= cols << (r * TILE_W);
-    }
-    m
-}
-
-/// The mask of lanes where every value of `v` is at least zero (NaN fails).
-#[inline]
-pub(crate) fn non_negative(v: &Lanes) -> LaneMask {
-    let mut m = 0;
-    for (j, x) in v.iter().enumerate() {
-        m |= LaneMask::from(*x >= 0.0) << j;
-    }
-    m
-}
-
-/// The mask of lanes where `|v| > bound` (NaN fails).
-#[inline]
-pub(crate) fn above_bound(v: &Lanes, bound: &Lanes) -> LaneMask {
-    let mut m = 0;
-    for j in 0..LANES {
-        m |= LaneMask::from(v[j].abs() > bound[j]) << j;
-    }
-    m
+    across
 }
 
 /// The lanes of a mask, in order.
@@ -148,31 +148,23 @@ mod tests {
 
     #[test]
     fn masks_select_the_right_lanes() {
-        assert_eq!(span_mask(0, 3, 0, 3), u16::MAX);
-        assert_eq!(span_mask(1, 2, 1, 1), 0b0110_0000);
-        assert_eq!(span_mask(3, 3, 0, 3), 0x8888);
-        let mut v = [1.0f32; LANES];
-        v[3] = -0.5;
-        v[7] = f32::NAN;
-        assert_eq!(non_negative(&v), !((1 << 3) | (1 << 7)));
-        let bound = [0.75f32; LANES];
-        assert_eq!(above_bound(&v, &bound), !(1 << 3 | 1 << 7));
         assert_eq!(lanes_of(0b1010_0001).collect::<Vec<_>>(), vec![0, 5, 7]);
     }
 
     #[test]
-    fn band_lanes_place_every_active_sample() {
-        let (w, h) = (6u32, 3u32);
+    fn rect_lanes_place_every_active_sample() {
+        let (w, h) = (10u32, 7u32);
         let centred: Vec<Vec3> = (0..w * h)
             .map(|i| Vec3::new(i as f32, -(i as f32), 0.5))
             .collect();
         let active: Vec<bool> = (0..w * h).map(|i| i % 5 != 0).collect();
-        let tiles = band_lanes(w, (0, h - 1), &centred, &active);
-        assert_eq!(tiles.len(), 2);
+        let mut tiles = Vec::new();
+        let across = rect_lanes(w, (4, 9), (0, h - 1), &centred, &active, &mut tiles);
+        assert_eq!((across, tiles.len()), (2, 4));
         let mut seen = 0;
         for (t, tile) in tiles.iter().enumerate() {
             for j in lanes_of(tile.active) {
-                let (x, y) = (t * 4 + j % 4, j / 4);
+                let (x, y) = (4 + (t % 2) * 4 + j % 4, (t / 2) * 4 + j / 4);
                 let i = y * w as usize + x;
                 assert!(active[i]);
                 assert_eq!(tile.x[j], centred[i].x);
@@ -180,6 +172,9 @@ mod tests {
                 seen += 1;
             }
         }
-        assert_eq!(seen, active.iter().filter(|a| **a).count());
+        let want = (0..w * h)
+            .filter(|&i| active[i as usize] && i % w >= 4)
+            .count();
+        assert_eq!(seen, want);
     }
 }

@@ -52,6 +52,7 @@
 #![deny(missing_docs)]
 
 mod angular;
+mod bins;
 mod budgets;
 mod centred;
 pub mod constant;
@@ -61,6 +62,7 @@ pub mod discrete;
 pub mod edges;
 mod lanes;
 mod light_shape;
+mod planar;
 mod presets;
 pub mod technique;
 pub mod wedges;

@@ -37,16 +37,20 @@ use shadow_core::technique::{Capabilities, Processor, SceneRef};
 use shadow_core::view_samples::ViewSample;
 use shadow_core::visibility::{PerSampleVisibility, PixelClass};
 
-use crate::angular::{AngularIndex, BATCH};
+use crate::angular::{AngularIndex, BATCH, QuadRanges};
+use crate::bins::{
+    BOXES, Boxes, Rect, ScanInput, SquarePairs, SquareScratch, WedgeBox, bits_of, rect_box,
+    square_pairs,
+};
 use crate::centred::CentredEdge;
 use crate::constant::{eye_constant, integration_constants};
 use crate::counters::{Packed, WIDTHS, width_for};
 use crate::coverage::{EdgeTest, RelativePolygon, RelativeSamples};
 use crate::discrete::{CoveredSamples, DiscreteTables, LineMasks};
 use crate::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
-use crate::lanes::BAND_ROWS;
 use crate::light_shape::LightShape;
-use crate::wedges::{Pair, Region, WedgePairs, band_pairs, region_rows, wedge_regions};
+use crate::planar::{PlanarEdge, PlanarSamples, PlanarTest};
+use crate::wedges::{FOLD_SLACK, Pair, Wedge, wedges};
 
 /// What per-sample visibility an estimate returns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -75,6 +79,20 @@ struct Prepared {
     polygon: Option<Vec<Vec3>>,
     /// The silhouette edges around the light centre (same indices as `silhouettes`).
     centred_edges: Vec<CentredEdge>,
+    /// The wedge of every silhouette edge (same indices), and their box-test data.
+    wedges: Vec<Wedge>,
+    boxes: Vec<WedgeBox>,
+    /// The light-plane form of the silhouette edges, for planar lights.
+    planar: Option<PlanarLight>,
+}
+
+/// A planar light's frame and its silhouette edges prepared for the light-plane test
+/// ([`crate::planar`]).
+struct PlanarLight {
+    u: Vec3,
+    v: Vec3,
+    normal: Vec3,
+    edges: Vec<PlanarEdge>,
 }
 
 /// Depth complexity sampling.
@@ -107,9 +125,6 @@ struct Frame<'a> {
     horizon: Vec<Horizon>,
     active: Vec<bool>,
     constants: Vec<i64>,
-    regions: Vec<Region>,
-    /// The rows of each region.
-    region_rows: Vec<(u32, u32)>,
     bits: u32,
     view: &'a ViewSamples,
 }
@@ -121,6 +136,11 @@ const FEW_CANDIDATES: u32 = 12;
 /// Fewest wedge pairs for which a pixel builds its angular index: below, the exact test on
 /// every sample costs less than the index.
 const INDEX_MIN_PAIRS: usize = 6;
+
+/// Receivers closer to the light's plane than this share of their distance to the light centre
+/// take the 3D form of the covered-sample test instead of the light-plane form (whose sector
+/// normals shrink with that height).
+const NEAR_PLANE: f32 = 1e-2;
 
 /// Relative error bound of the per-sample horizon test in `f32`, against
 /// `|n| (|c| + r + |p|)` (normal, light centre and radius, receiver): a light whose every point
@@ -160,6 +180,8 @@ struct Scratch {
     polygon: RelativePolygon,
     above: Vec<u64>,
     mask: Vec<u64>,
+    /// The samples in the light plane (the light-plane test).
+    planar_samples: PlanarSamples,
     /// Tests waiting for their candidates, and their weights.
     batch: Vec<EdgeTest>,
     batch_k: Vec<i64>,
@@ -177,12 +199,12 @@ struct Scratch {
     vis: Vec<f32>,
 }
 
-/// Per-thread buffers of a band: its pairs, their unsorted list, and the pixels' scratch
-/// (kept from band to band, so that they are allocated once per thread).
+/// Per-thread buffers of a strip: its pairs, the scan's buffers, and the pixels' scratch (kept
+/// from strip to strip, so that they are allocated once per thread).
 #[derive(Default)]
-struct BandScratch {
-    pairs: WedgePairs,
-    found: Vec<(u32, Pair)>,
+struct StripBuffers {
+    pairs: SquarePairs,
+    scan: SquareScratch,
     scratch: Scratch,
 }
 
@@ -199,6 +221,8 @@ struct Counts {
     negative: u64,
     ties: u64,
     scanned: u64,
+    tile_wedges: u64,
+    square_wedges: u64,
     pairs: u64,
     off_light: u64,
     sector_empty: u64,
@@ -217,6 +241,8 @@ impl Counts {
         self.negative += o.negative;
         self.ties += o.ties;
         self.scanned += o.scanned;
+        self.tile_wedges += o.tile_wedges;
+        self.square_wedges += o.square_wedges;
         self.pairs += o.pairs;
         self.off_light += o.off_light;
         self.sector_empty += o.sector_empty;
@@ -332,19 +358,7 @@ impl Dcs {
         let bits = self.forced_bits.unwrap_or_else(|| width_for(max_constant));
         stats.add("max-integration-constant", max_constant);
         stats.add("counter-bits", bits as u64);
-        let (regions, unbounded) = stats.time("wedges", || {
-            wedge_regions(
-                &p.edges,
-                &p.silhouettes,
-                &p.shape,
-                view.raster_view(),
-                &origins,
-                &active,
-            )
-        });
-        stats.add("wedges", regions.len() as u64);
-        let region_rows = region_rows(&regions);
-        stats.add("wedges-unbounded", unbounded);
+        stats.add("wedges", p.wedges.len() as u64);
         let cd = p.shape.center.as_dvec3();
         let centred = origins
             .par_iter()
@@ -356,61 +370,123 @@ impl Dcs {
             horizon,
             active,
             constants,
-            regions,
-            region_rows,
             bits,
             view,
         })
     }
 
-    /// Runs the per-pixel pass over the rows `rows`: the band's wedge pairs, then every view
-    /// sample, handed to `visit` with its class and the scratch holding its samples and
-    /// visibilities.
-    fn run_band(
+    /// Runs the per-pixel pass over the strip `rect`: its wedge pairs (from its block's wedges
+    /// `block`), then every view sample, handed to `visit` with its class and the scratch holding
+    /// its samples and visibilities.
+    fn run_strip(
         &self,
         p: &Prepared,
         f: &Frame,
-        rows: (u32, u32),
+        wedges: &[u32],
+        rect: Rect,
         counts: &mut Counts,
-        band: &mut BandScratch,
+        buffers: &mut StripBuffers,
         mut visit: impl FnMut(usize, &ViewSample, PixelClass, &Scratch),
     ) {
         let view = f.view;
-        let BandScratch {
+        let StripBuffers {
             pairs,
-            found,
+            scan,
             scratch,
-        } = band;
-        band_pairs(
-            &p.edges,
-            &f.regions,
-            &f.region_rows,
-            p.shape.center.as_dvec3(),
-            view.raster_view(),
-            rows,
-            &f.origins,
-            &f.centred,
-            &f.active,
-            p.extent,
-            pairs,
-            found,
-        );
+        } = buffers;
+        square_pairs(&Self::scan_input(p, f), wedges, rect, pairs, scan);
         counts.scanned += pairs.scanned;
-        counts.pairs += pairs.entries.len() as u64;
+        counts.tile_wedges += pairs.tile_wedges;
+        counts.square_wedges += pairs.square_wedges;
+        counts.pairs += pairs.len() as u64;
         let w = view.width() as usize;
-        for i in rows.0 as usize * w..(rows.1 as usize + 1) * w {
+        for i in rect.pixels(view.width()) {
             let Some(s) = view.get(i) else { continue };
-            let class = self.pixel(p, f, i, &s, pairs.of(i), scratch, counts);
+            let (x, y) = ((i % w) as u32, (i / w) as u32);
+            let class = self.pixel(p, f, i, &s, pairs.of(x, y), scratch, counts);
             visit(i, &s, class, scratch);
         }
     }
 
-    /// The bands of rows of a view.
-    fn bands(view: &ViewSamples) -> Vec<(u32, u32)> {
-        (0..view.height())
-            .step_by(BAND_ROWS as usize)
-            .map(|y| (y, (y + BAND_ROWS - 1).min(view.height() - 1)))
-            .collect()
+    /// What the wedge scan reads of a frame.
+    fn scan_input<'a>(p: &'a Prepared, f: &'a Frame) -> ScanInput<'a> {
+        ScanInput {
+            edges: &p.edges,
+            wedges: &p.wedges,
+            boxes: &p.boxes,
+            c: p.shape.center.as_dvec3(),
+            width: f.view.width(),
+            origins: &f.origins,
+            centred: &f.centred,
+            active: &f.active,
+            slack: (FOLD_SLACK * p.extent) as f32,
+        }
+    }
+
+    /// Runs `work` on every square of the view in parallel, with the wedges its box keeps (the
+    /// box hierarchy of [`crate::bins`]: blocks, then their squares). Returns each square's
+    /// result and the number of (block, wedge) pairs kept.
+    fn strips<T: Send>(
+        &self,
+        p: &Prepared,
+        f: &Frame,
+        work: impl Fn(Rect, &[u32], &mut StripBuffers) -> T + Sync + Send,
+    ) -> (Vec<(Rect, T)>, u64) {
+        let view = f.view;
+        let slack = (FOLD_SLACK * p.extent) as f32;
+        let width = view.width();
+        let blocks = crate::bins::blocks(width, view.height());
+        // Every wedge against the block boxes, up to 64 blocks per test.
+        let groups: Vec<Boxes> = blocks
+            .chunks(BOXES)
+            .map(|g| {
+                let mut b = Boxes::default();
+                b.set(
+                    g.iter()
+                        .map(|(r, _)| rect_box(*r, width, &f.centred, &f.active)),
+                );
+                b
+            })
+            .collect();
+        let masks: Vec<u64> = p
+            .boxes
+            .par_iter()
+            .flat_map_iter(|w| groups.iter().map(move |g| g.test(w, slack)))
+            .collect();
+        let ng = groups.len();
+        let parts: Vec<(Vec<(Rect, T)>, u64)> = blocks
+            .par_iter()
+            .enumerate()
+            .map(|(bi, (_, squares))| {
+                let (g, bit) = (bi / BOXES, bi % BOXES);
+                let kept: Vec<u32> = (0..p.boxes.len() as u32)
+                    .filter(|&wi| masks[wi as usize * ng + g] >> bit & 1 == 1)
+                    .collect();
+                // The block's wedges against its squares' boxes.
+                let mut sq = Boxes::default();
+                sq.set(
+                    squares
+                        .iter()
+                        .map(|r| rect_box(*r, width, &f.centred, &f.active)),
+                );
+                let mut lists: Vec<Vec<u32>> = vec![Vec::new(); squares.len()];
+                for &wi in &kept {
+                    for s in bits_of(sq.test(&p.boxes[wi as usize], slack)) {
+                        lists[s].push(wi);
+                    }
+                }
+                let out = squares
+                    .par_iter()
+                    .zip(&lists)
+                    .map_init(StripBuffers::default, |buffers, (&r, list)| {
+                        (r, work(r, list, buffers))
+                    })
+                    .collect();
+                (out, kept.len() as u64)
+            })
+            .collect();
+        let kept = parts.iter().map(|(_, k)| k).sum();
+        (parts.into_iter().flat_map(|(v, _)| v).collect(), kept)
     }
 
     /// The horizon class of a receiver: the reference's rule, a sample counts when it lies
@@ -495,11 +571,28 @@ impl Dcs {
             && (self.covered == CoveredSamples::Exact || refined.is_some())
             && entries.len() >= INDEX_MIN_PAIRS;
         let all_above = horizon == Horizon::Above;
+        // The light-plane form of the test (planar lights, exact covered samples, a receiver
+        // clear of the light's plane).
+        let planar = match (&p.planar, self.covered) {
+            (Some(pl), CoveredSamples::Exact)
+                if f.centred[i].dot(pl.normal).abs() > NEAR_PLANE * f.centred[i].length() =>
+            {
+                Some(pl)
+            }
+            _ => None,
+        };
         let mut ready = horizon == Horizon::Mixed;
         if ready {
-            self.sample_setup(p, s, origin, indexed, all_above, scratch);
+            self.sample_setup(p, s, origin, indexed, all_above, planar.is_some(), scratch);
         }
-        for pair in entries {
+        if let (Some(pl), false) = (planar, entries.is_empty()) {
+            if !ready {
+                self.sample_setup(p, s, origin, indexed, all_above, true, scratch);
+                ready = true;
+            }
+            Self::planar_pairs(p, pl, f.centred[i], pc, entries, indexed, scratch, counts);
+        }
+        for pair in entries.iter().filter(|_| planar.is_none()) {
             let Some(test) = p.centred_edges[pair.edge as usize].test(pc) else {
                 counts.ties += 1;
                 continue;
@@ -509,7 +602,7 @@ impl Dcs {
                 continue;
             }
             if !ready {
-                self.sample_setup(p, s, origin, indexed, all_above, scratch);
+                self.sample_setup(p, s, origin, indexed, all_above, false, scratch);
                 ready = true;
             }
             if indexed {
@@ -617,7 +710,9 @@ impl Dcs {
     }
 
     /// A per-sample pixel's samples: positions, the horizon mask, the samples relative to the
-    /// view sample, the angular index (`indexed`), and empty update lists.
+    /// view sample (in the light plane with `planar`), the angular index (`indexed`), and empty
+    /// update lists.
+    #[allow(clippy::too_many_arguments)]
     fn sample_setup(
         &self,
         p: &Prepared,
@@ -625,6 +720,7 @@ impl Dcs {
         origin: Vec3,
         indexed: bool,
         all_above: bool,
+        planar: bool,
         scratch: &mut Scratch,
     ) {
         let n = self.sampler.count() as usize;
@@ -663,11 +759,23 @@ impl Dcs {
         }
         scratch.masks.clear();
         scratch.weights.clear();
-        scratch.relative.set(origin, &scratch.positions);
-        if let (Some(plane), true) = (&p.shape.plane, indexed) {
-            scratch
-                .angular
-                .build(plane, p.shape.center, &scratch.positions);
+        match (&p.planar, planar) {
+            (Some(pl), true) => {
+                scratch
+                    .planar_samples
+                    .set(&scratch.positions, p.shape.center, pl.u, pl.v);
+                if indexed {
+                    scratch.angular.build_planar(&scratch.planar_samples, n);
+                }
+            }
+            _ => {
+                scratch.relative.set(origin, &scratch.positions);
+                if let (Some(plane), true) = (&p.shape.plane, indexed) {
+                    scratch
+                        .angular
+                        .build(plane, p.shape.center, &scratch.positions);
+                }
+            }
         }
         scratch.mask.clear();
         scratch.mask.resize(words, 0);
@@ -779,6 +887,73 @@ impl Dcs {
         scratch.batch_edge.clear();
     }
 
+    /// The covered samples of every pair of a pixel by the light-plane test (planar lights,
+    /// samples set up), four pairs at a time: their tests, their sectors' bucket ranges (with
+    /// `indexed`; otherwise every sample is a candidate), then the exact test on the
+    /// candidates, appended to the pixel's updates when any.
+    #[allow(clippy::too_many_arguments)]
+    fn planar_pairs(
+        p: &Prepared,
+        pl: &PlanarLight,
+        pf: Vec3,
+        pc: DVec3,
+        entries: &[Pair],
+        indexed: bool,
+        scratch: &mut Scratch,
+        counts: &mut Counts,
+    ) {
+        let words = scratch.above.len();
+        let pf_norm = pf.length();
+        scratch.mask.resize(words, 0);
+        for chunk in entries.chunks(4) {
+            let mut tests = [PlanarTest::NONE; 4];
+            let mut valid = 0u32;
+            for (j, pair) in chunk.iter().enumerate() {
+                let e = pair.edge as usize;
+                match pl.edges[e].test(pf, pf_norm, &p.centred_edges[e], pc) {
+                    Some(t) => {
+                        tests[j] = t;
+                        valid |= 1 << j;
+                    }
+                    None => counts.ties += 1,
+                }
+            }
+            counts.edge_tests += u64::from(valid.count_ones());
+            let ranges = indexed.then(|| QuadRanges::of_tests(&tests));
+            for (j, pair) in chunk.iter().enumerate() {
+                if valid >> j & 1 == 0 {
+                    continue;
+                }
+                let test = &tests[j];
+                let mut hit = 0u64;
+                if let Some(r) = &ranges {
+                    let cand = &mut scratch.batch_candidates;
+                    cand.resize(words, 0);
+                    if !scratch.angular.quad_candidates(r, j, &scratch.above, cand) {
+                        counts.sector_empty += 1;
+                        continue;
+                    }
+                    for (w, &c) in cand.iter().enumerate() {
+                        let m = test.covered_in(&scratch.planar_samples, w, c);
+                        scratch.mask[w] = m;
+                        hit |= m;
+                    }
+                } else {
+                    for (w, &a) in scratch.above.iter().enumerate() {
+                        let m = test.covered_word(&scratch.planar_samples, w) & a;
+                        scratch.mask[w] = m;
+                        hit |= m;
+                    }
+                }
+                if hit != 0 {
+                    counts.covered_updates += 1;
+                    scratch.masks.extend_from_slice(&scratch.mask);
+                    scratch.weights.push(i64::from(pair.k));
+                }
+            }
+        }
+    }
+
     /// Direct illumination of every view sample by DCS eq. 6: the light samples' contributions
     /// weighted by their binary visibility (saturated opacity sums with semi-opaque occluders).
     ///
@@ -788,17 +963,19 @@ impl Dcs {
         let p = self.prepared()?;
         let mut stats = Stats::default();
         let f = self.frame(p, view, &mut stats)?;
-        let w = view.width() as usize;
-        let bands = Self::bands(view);
-        let parts: Vec<Vec<Vec3>> = bands
-            .par_iter()
-            .map_init(BandScratch::default, |band, &rows| {
-                let first = rows.0 as usize * w;
-                let mut out = vec![Vec3::ZERO; (rows.1 - rows.0 + 1) as usize * w];
-                let mut counts = Counts::default();
-                let mut units = Vec::new();
-                let mut samples = Vec::new();
-                self.run_band(p, &f, rows, &mut counts, band, |i, s, _, scratch| {
+        let (parts, _) = self.strips(p, &f, |rect, block, buffers| {
+            let mut out = Vec::with_capacity(rect.len());
+            let mut counts = Counts::default();
+            let mut units = Vec::new();
+            let mut samples = Vec::new();
+            self.run_strip(
+                p,
+                &f,
+                block,
+                rect,
+                &mut counts,
+                buffers,
+                |i, s, _, scratch| {
                     let light = p.light.as_ref();
                     let samples: &[LightSample] = if scratch.samples.is_empty() {
                         self.sampler.unit_samples(s.pixel, &mut units);
@@ -810,12 +987,15 @@ impl Dcs {
                     };
                     let albedo = p.scene.albedo(s.triangle as usize);
                     let vis = &scratch.vis;
-                    out[i - first] = pixel_direct(s, albedo, light, samples, |k| vis[k]);
-                });
-                out
-            })
-            .collect();
-        let out: Vec<Vec3> = parts.into_iter().flatten().collect();
+                    out.push((i, pixel_direct(s, albedo, light, samples, |k| vis[k])));
+                },
+            );
+            out
+        });
+        let mut out = vec![Vec3::ZERO; view.len()];
+        for (i, d) in parts.into_iter().flat_map(|(_, v)| v) {
+            out[i] = d;
+        }
         Ok(out)
     }
 }
@@ -937,7 +1117,24 @@ impl ShadowTechnique for Dcs {
             .iter()
             .map(|&i| CentredEdge::new(&edges[i as usize], cd))
             .collect();
+        let wedges = stats.time("wedges", || wedges(&edges, &sil, &shape));
+        let planar = shape.plane.as_ref().map(|pl| {
+            let (u, v) = (pl.u.as_dvec3(), pl.v.as_dvec3());
+            PlanarLight {
+                u: pl.u,
+                v: pl.v,
+                normal: pl.u.cross(pl.v),
+                edges: sil
+                    .par_iter()
+                    .map(|&i| PlanarEdge::new(&edges[i as usize], cd, u, v))
+                    .collect(),
+            }
+        });
+        let boxes = wedges.iter().map(WedgeBox::of).collect();
         self.prepared = Some(Prepared {
+            planar,
+            wedges,
+            boxes,
             polygon,
             centred_edges,
             scene,
@@ -970,38 +1167,43 @@ impl ShadowTechnique for Dcs {
             counts: Counts,
         }
         let output = self.output;
-        let bands = Self::bands(view);
-        let rows: Vec<Row> = stats.time("depth-complexity", || {
-            bands
-                .par_iter()
-                .map_init(BandScratch::default, |band, &rows| {
-                    let m = (rows.1 - rows.0 + 1) as usize * w;
-                    let first = rows.0 as usize * w;
-                    let mut r = Row {
-                        v: vec![0.0; m],
-                        rgb: vec![Vec3::ZERO; if textured { m } else { 0 }],
-                        class: vec![PixelClass::Background; m],
-                        bits: vec![
-                            0;
-                            if output == PerSampleOutput::Bits {
-                                m * words
-                            } else {
-                                0
-                            }
-                        ],
-                        depth: vec![
-                            0;
-                            if output == PerSampleOutput::Counters {
-                                m * n
-                            } else {
-                                0
-                            }
-                        ],
-                        counts: Counts::default(),
-                    };
-                    let mut counts = Counts::default();
-                    self.run_band(p, &f, rows, &mut counts, band, |i, _, class, scratch| {
-                        let x = i - first;
+        let (strips, block_wedges) = stats.time("depth-complexity", || {
+            self.strips(p, &f, |rect, block, buffers| {
+                let m = rect.len();
+                let rw = rect.width() as usize;
+                let mut r = Row {
+                    v: vec![0.0; m],
+                    rgb: vec![Vec3::ZERO; if textured { m } else { 0 }],
+                    class: vec![PixelClass::Background; m],
+                    bits: vec![
+                        0;
+                        if output == PerSampleOutput::Bits {
+                            m * words
+                        } else {
+                            0
+                        }
+                    ],
+                    depth: vec![
+                        0;
+                        if output == PerSampleOutput::Counters {
+                            m * n
+                        } else {
+                            0
+                        }
+                    ],
+                    counts: Counts::default(),
+                };
+                let mut counts = Counts::default();
+                self.run_strip(
+                    p,
+                    &f,
+                    block,
+                    rect,
+                    &mut counts,
+                    buffers,
+                    |i, _, class, scratch| {
+                        let x =
+                            (i / w - rect.rows.0 as usize) * rw + (i % w - rect.cols.0 as usize);
                         r.class[x] = class;
                         let vis = &scratch.vis;
                         // Lit and umbra pixels (most of an image): every sample alike.
@@ -1053,31 +1255,51 @@ impl ShadowTechnique for Dcs {
                             }
                             PerSampleOutput::None => {}
                         }
-                    });
-                    r.counts = counts;
-                    r
-                })
-                .collect()
+                    },
+                );
+                r.counts = counts;
+                r
+            })
         });
         let mut vis = if textured {
             VisibilityImage::rgb_buffer(view)
         } else {
             VisibilityImage::scalar(view)
         };
-        let mut classes = Vec::with_capacity(view.len());
+        let mut classes = vec![PixelClass::Background; view.len()];
         let mut counts = Counts::default();
-        let mut bits = Vec::new();
-        let mut depth = Vec::new();
-        for (&band, r) in bands.iter().zip(rows) {
-            let range = band.0 as usize * w..(band.1 as usize + 1) * w;
-            if textured {
-                vis.rgbs_mut()[range].copy_from_slice(&r.rgb);
+        let mut bits = vec![
+            0u64;
+            if output == PerSampleOutput::Bits {
+                view.len() * words
             } else {
-                vis.scalars_mut()[range].copy_from_slice(&r.v);
+                0
             }
-            classes.extend(r.class);
-            bits.extend(r.bits);
-            depth.extend(r.depth);
+        ];
+        let mut depth = vec![
+            0u32;
+            if output == PerSampleOutput::Counters {
+                view.len() * n
+            } else {
+                0
+            }
+        ];
+        for (rect, r) in strips {
+            for (j, i) in rect.pixels(view.width()).enumerate() {
+                if textured {
+                    vis.rgbs_mut()[i] = r.rgb[j];
+                } else {
+                    vis.scalars_mut()[i] = r.v[j];
+                }
+                classes[i] = r.class[j];
+                if !r.bits.is_empty() {
+                    bits[i * words..(i + 1) * words]
+                        .copy_from_slice(&r.bits[j * words..(j + 1) * words]);
+                }
+                if !r.depth.is_empty() {
+                    depth[i * n..(i + 1) * n].copy_from_slice(&r.depth[j * n..(j + 1) * n]);
+                }
+            }
             counts.add(&r.counts);
         }
         vis.set_classes(classes)?;
@@ -1102,6 +1324,9 @@ impl ShadowTechnique for Dcs {
         stats.add("negative-depth-complexity", counts.negative);
         stats.add("edge-ties", counts.ties);
         stats.add("wedge-pixels-scanned", counts.scanned);
+        stats.add("bin-block-wedges", block_wedges);
+        stats.add("bin-square-wedges", counts.square_wedges);
+        stats.add("bin-tile-wedges", counts.tile_wedges);
         stats.add("wedge-pairs", counts.pairs);
         stats.add("wedge-pairs-off-light", counts.off_light);
         stats.add("wedge-pairs-empty-sector", counts.sector_empty);

@@ -1,0 +1,385 @@
+//! The spatial structure that finds the view samples inside each penumbra wedge (DCS section
+//! 4.2, Algorithm 1 line 2, "for all p in w_e"): a hierarchy of boxes over the light-centred view
+//! samples, walked from the top with every wedge.
+//!
+//! * **Blocks** of [`BLOCK`] x [`BLOCK`] pixels: every wedge of the light against the boxes of
+//!   up to [`BOXES`] blocks at once; each block lists the wedges its box keeps.
+//! * **Squares** of [`SQUARE`] x [`SQUARE`] pixels: each wedge of a block against the boxes of
+//!   the block's squares. A square is also the unit of the per-pixel pass: its pairs are kept
+//!   until its pixels are done, which bounds their memory on scenes of very high depth
+//!   complexity (`grass`).
+//! * **Tiles** of [`TILE_W`] x [`TILE_H`] pixels: each wedge of a square against the boxes of
+//!   the square's tiles.
+//! * **View samples** of a tile ([`crate::lanes`]): a surviving wedge's planes and its weight
+//!   `k_e(p)` on every view sample at once; each view sample inside the planes with a non-zero
+//!   weight makes a (pixel, edge) pair.
+//!
+//! A box keeps a wedge when none of the wedge's bounding planes ([`crate::wedges::wedge_planes`])
+//! has the whole box on its negative side, and the edge may be a silhouette from some point of
+//! the box (its two face planes, with a slack). A test loads one wedge's planes and evaluates
+//! them on the boxes four at a time, centres and half extents in packed vectors. Boxes are
+//! padded by their own rounding, so that no test rejects a view sample that the exact test on
+//! the lanes would keep.
+
+use glam::{BVec4A, DVec3, Vec3, Vec4};
+
+use crate::centred::CentredPlane;
+use crate::edges::SceneEdge;
+use crate::lanes::{TILE_H, TILE_W, TileLanes, TileQuads, lanes_of, rect_lanes};
+use crate::wedges::{Pair, Wedge};
+
+/// Side of a block, in pixels (a multiple of [`SQUARE`]).
+pub(crate) const BLOCK: u32 = 64;
+
+/// Side of a square, in pixels (a multiple of [`TILE_W`] and [`TILE_H`]).
+pub(crate) const SQUARE: u32 = 16;
+
+/// Bounding planes per wedge in the box tests: more are dropped (any subset of a wedge's
+/// bounding planes bounds it).
+const BOX_PLANES: usize = 6;
+
+/// Relative padding of a box, far above the rounding of its centre and of a plane evaluated there.
+const BOX_PAD: f32 = 1e-6;
+
+/// Boxes per [`Boxes`] (one bit each in a test's mask).
+pub(crate) const BOXES: usize = 64;
+
+/// A plane for box tests: `n.x`, `n.y`, `n.z`, `d`, `|n.x|`, `|n.y|`, `|n.z|`.
+type BoxPlane = [f32; 7];
+
+/// The plane every box passes (`0 . x + 1 >= 0`): unused plane slots.
+const OPEN: BoxPlane = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
+
+/// A wedge's bounding planes and the planes of its edge's two faces, for box tests.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct WedgeBox {
+    planes: [BoxPlane; BOX_PLANES],
+    fold: [BoxPlane; 2],
+}
+
+impl WedgeBox {
+    /// The box-test data of wedge `w`.
+    pub fn of(w: &Wedge) -> Self {
+        let plane = |p: &CentredPlane| -> BoxPlane {
+            let (n, d) = p.coefficients();
+            [n.x, n.y, n.z, d, n.x.abs(), n.y.abs(), n.z.abs()]
+        };
+        // No fold planes: both open, which every box passes.
+        let fold = match &w.fold {
+            Some((a, b)) => [plane(a), plane(b)],
+            None => [OPEN, OPEN],
+        };
+        Self {
+            planes: std::array::from_fn(|k| w.planes.get(k).map_or(OPEN, plane)),
+            fold,
+        }
+    }
+}
+
+/// Up to [`BOXES`] boxes of light-centred view samples in packed form (centres and half extents
+/// four boxes to a vector), padded by the rounding of the tests.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Boxes {
+    m: [Vec<Vec4>; 3],
+    h: [Vec<Vec4>; 3],
+    /// The boxes that exist (one bit each).
+    valid: u64,
+}
+
+impl Boxes {
+    /// Sets the boxes (`None`: a box without view samples, which no test keeps).
+    pub fn set(&mut self, boxes: impl IntoIterator<Item = Option<(Vec3, Vec3)>>) {
+        let mut flat: Vec<[f32; 6]> = Vec::with_capacity(BOXES);
+        self.valid = 0;
+        for (i, b) in boxes.into_iter().enumerate() {
+            assert!(i < BOXES, "at most {BOXES} boxes");
+            if let Some((lo, hi)) = b {
+                let m = (lo + hi) * 0.5;
+                let h = (hi - lo) * 0.5;
+                let h = h + (m.abs() + h) * BOX_PAD;
+                flat.push([m.x, m.y, m.z, h.x, h.y, h.z]);
+                self.valid |= 1 << i;
+            } else {
+                flat.push([0.0; 6]);
+            }
+        }
+        let quads = flat.len().div_ceil(4);
+        flat.resize(quads * 4, [0.0; 6]);
+        for (k, v) in self.m.iter_mut().chain(self.h.iter_mut()).enumerate() {
+            v.clear();
+            v.extend(
+                flat.chunks(4)
+                    .map(|q| Vec4::new(q[0][k], q[1][k], q[2][k], q[3][k])),
+            );
+        }
+    }
+
+    /// The boxes (one bit each) that may hold a view sample of wedge `w`: no bounding plane has
+    /// the whole box on its negative side, and the fold planes do not both surely differ in
+    /// sign over it (a NaN keeps the box). `slack` is the fold test's slack.
+    #[inline]
+    pub fn test(&self, w: &WedgeBox, slack: f32) -> u64 {
+        let quads = self.m[0].len().min(BOXES / 4);
+        let [m0, m1, m2] = [
+            &self.m[0][..quads],
+            &self.m[1][..quads],
+            &self.m[2][..quads],
+        ];
+        let [h0, h1, h2] = [
+            &self.h[0][..quads],
+            &self.h[1][..quads],
+            &self.h[2][..quads],
+        ];
+        let mut reject = [BVec4A::splat(false); BOXES / 4];
+        for p in &w.planes {
+            let [nx, ny, nz, d, ax, ay, az] = p.map(Vec4::splat);
+            for q in 0..quads {
+                let v = nx * m0[q]
+                    + ny * m1[q]
+                    + nz * m2[q]
+                    + d
+                    + (ax * h0[q] + ay * h1[q] + az * h2[q]);
+                reject[q] |= v.cmplt(Vec4::ZERO);
+            }
+        }
+        let [f1, f2] = w.fold.map(|p| p.map(Vec4::splat));
+        let s = Vec4::splat(slack);
+        let mut mask = 0u64;
+        for q in 0..quads {
+            let centre = |p: &[Vec4; 7]| p[0] * m0[q] + p[1] * m1[q] + p[2] * m2[q] + p[3];
+            let radius = |p: &[Vec4; 7]| p[4] * h0[q] + p[5] * h1[q] + p[6] * h2[q];
+            let (c1, r1, c2, r2) = (centre(&f1), radius(&f1), centre(&f2), radius(&f2));
+            // Surely no silhouette: the fold planes surely differ in sign over the whole box.
+            let not_both_positive = (c1 + r1).cmple(-s) | (c2 + r2).cmple(-s);
+            let not_both_negative = (c1 - r1).cmpge(s) | (c2 - r2).cmpge(s);
+            let out = reject[q] | (not_both_positive & not_both_negative);
+            mask |= u64::from(!out.bitmask() & 0xf) << (4 * q);
+        }
+        mask & self.valid
+    }
+}
+
+/// The set bits of a mask, in order.
+#[inline]
+pub(crate) fn bits_of(mut m: u64) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (m != 0).then(|| {
+            let j = m.trailing_zeros() as usize;
+            m &= m - 1;
+            j
+        })
+    })
+}
+
+/// A rectangle of pixels, inclusive bounds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Rect {
+    pub cols: (u32, u32),
+    pub rows: (u32, u32),
+}
+
+impl Rect {
+    /// Number of pixels.
+    pub fn len(&self) -> usize {
+        ((self.cols.1 - self.cols.0 + 1) * (self.rows.1 - self.rows.0 + 1)) as usize
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> u32 {
+        self.cols.1 - self.cols.0 + 1
+    }
+
+    /// The image indices of the pixels, row by row.
+    pub fn pixels(&self, image_width: u32) -> impl Iterator<Item = usize> + use<> {
+        let (c, r, w) = (self.cols, self.rows, image_width as usize);
+        (r.0..=r.1).flat_map(move |y| (c.0..=c.1).map(move |x| y as usize * w + x as usize))
+    }
+}
+
+/// The rectangles of side `side` covering `cols` x `rows`, row by row.
+fn grid(cols: (u32, u32), rows: (u32, u32), side: u32) -> impl Iterator<Item = Rect> {
+    (rows.0..=rows.1).step_by(side as usize).flat_map(move |y| {
+        (cols.0..=cols.1).step_by(side as usize).map(move |x| Rect {
+            cols: (x, (x + side - 1).min(cols.1)),
+            rows: (y, (y + side - 1).min(rows.1)),
+        })
+    })
+}
+
+/// The blocks of an image, each with its squares.
+pub(crate) fn blocks(width: u32, height: u32) -> Vec<(Rect, Vec<Rect>)> {
+    if width == 0 || height == 0 {
+        return Vec::new();
+    }
+    grid((0, width - 1), (0, height - 1), BLOCK)
+        .map(|b| (b, grid(b.cols, b.rows, SQUARE).collect()))
+        .collect()
+}
+
+/// The box of the active light-centred view samples of `rect`, `None` when it has none.
+pub(crate) fn rect_box(
+    rect: Rect,
+    width: u32,
+    centred: &[Vec3],
+    active: &[bool],
+) -> Option<(Vec3, Vec3)> {
+    let mut b: Option<(Vec3, Vec3)> = None;
+    for i in rect.pixels(width) {
+        if active[i] {
+            let p = centred[i];
+            b = Some(match b {
+                Some((lo, hi)) => (lo.min(p), hi.max(p)),
+                None => (p, p),
+            });
+        }
+    }
+    b
+}
+
+/// The (pixel, edge, weight) pairs of a square, grouped by pixel in edge order (CSR).
+#[derive(Debug, Default)]
+pub(crate) struct SquarePairs {
+    rect: Option<Rect>,
+    /// `start[j]..start[j + 1]` indexes the entries of the square's pixel `j` (row by row).
+    start: Vec<u32>,
+    /// The pairs, by pixel.
+    entries: Vec<Pair>,
+    /// View samples tested against a wedge's planes and weight.
+    pub scanned: u64,
+    /// (tile, wedge) candidates evaluated on the tile's view samples.
+    pub tile_wedges: u64,
+    /// Wedges kept by the square's box.
+    pub square_wedges: u64,
+}
+
+impl SquarePairs {
+    /// The entries of the pixel at column `x`, row `y` (inside the square).
+    pub fn of(&self, x: u32, y: u32) -> &[Pair] {
+        let r = self.rect.expect("pairs of a square");
+        let j = ((y - r.rows.0) * r.width() + (x - r.cols.0)) as usize;
+        &self.entries[self.start[j] as usize..self.start[j + 1] as usize]
+    }
+
+    /// Number of pairs.
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+}
+
+/// Per-thread buffers of the square scan.
+#[derive(Default)]
+pub(crate) struct SquareScratch {
+    tiles: Boxes,
+    found: Vec<(u32, Pair)>,
+    lanes: Vec<TileLanes>,
+}
+
+/// What the wedge scan reads of a frame.
+pub(crate) struct ScanInput<'a> {
+    pub edges: &'a [SceneEdge],
+    pub wedges: &'a [Wedge],
+    pub boxes: &'a [WedgeBox],
+    /// The light centre.
+    pub c: DVec3,
+    pub width: u32,
+    pub origins: &'a [Vec3],
+    pub centred: &'a [Vec3],
+    pub active: &'a [bool],
+    /// Slack of the fold test.
+    pub slack: f32,
+}
+
+/// The pairs of square `rect` from the wedges its box keeps (`wedges`, silhouette indices in
+/// order): each tile's box, then the tile's view samples (exact weight where the
+/// single-precision signs are uncertain).
+pub(crate) fn square_pairs(
+    input: &ScanInput,
+    wedges: &[u32],
+    rect: Rect,
+    out: &mut SquarePairs,
+    scratch: &mut SquareScratch,
+) {
+    let n = rect.len();
+    out.rect = Some(rect);
+    out.entries.clear();
+    out.start.clear();
+    out.start.resize(n + 1, 0);
+    out.scanned = 0;
+    out.tile_wedges = 0;
+    out.square_wedges = wedges.len() as u64;
+    let SquareScratch {
+        tiles,
+        found,
+        lanes,
+    } = scratch;
+    found.clear();
+    let across = rect_lanes(
+        input.width,
+        rect.cols,
+        rect.rows,
+        input.centred,
+        input.active,
+        lanes,
+    );
+    tiles.set(lanes.iter().map(TileLanes::bounds));
+    let quads: Vec<TileQuads> = lanes.iter().map(TileLanes::quads).collect();
+    let w = input.width as usize;
+    let sw = rect.width();
+    for &wi in wedges {
+        let wedge = &input.wedges[wi as usize];
+        let mask = tiles.test(&input.boxes[wi as usize], input.slack);
+        out.tile_wedges += u64::from(mask.count_ones());
+        for t in bits_of(mask) {
+            let tile = &lanes[t];
+            out.scanned += u64::from(tile.active.count_ones());
+            let inside = CentredPlane::inside_all(&wedge.planes, &quads[t], tile.active);
+            if inside == 0 {
+                continue;
+            }
+            let x0 = rect.cols.0 + (t % across) as u32 * TILE_W;
+            let y0 = rect.rows.0 + (t / across) as u32 * TILE_H;
+            let e = &input.edges[wedge.edge as usize];
+            let fast = wedge
+                .weight
+                .as_ref()
+                .and_then(|f| f.weight_lanes(&quads[t], inside));
+            for j in lanes_of(inside) {
+                let (x, y) = (x0 + j as u32 % TILE_W, y0 + j as u32 / TILE_W);
+                let k = match &fast {
+                    Some(f) if f.certain >> j & 1 == 1 => i64::from(f.k[j]),
+                    _ => {
+                        let o = input.origins[y as usize * w + x as usize].as_dvec3();
+                        match e.sweep_weight(o, input.c, false) {
+                            Some(k) => k,
+                            None => continue,
+                        }
+                    }
+                };
+                if k != 0 {
+                    let k = k.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+                    let local = (y - rect.rows.0) * sw + (x - rect.cols.0);
+                    found.push((local, Pair { edge: wi, k }));
+                }
+            }
+        }
+    }
+    // Counting sort by pixel, stable: each pixel's pairs stay in wedge order. `start[j + 1]`
+    // first counts pixel `j`'s pairs; after the running sum, `start[j]` is pixel `j`'s fill
+    // position, which ends at the start of pixel `j + 1`.
+    let start = &mut out.start;
+    for (j, _) in found.iter() {
+        start[*j as usize + 1] += 1;
+    }
+    for j in 0..n {
+        start[j + 1] += start[j];
+    }
+    out.entries.resize(found.len(), Pair { edge: 0, k: 0 });
+    for (j, pair) in found.iter() {
+        let slot = &mut start[*j as usize];
+        out.entries[*slot as usize] = *pair;
+        *slot += 1;
+    }
+    // Each `start[j]` now holds the start of pixel `j + 1`: shift back.
+    start.copy_within(0..n, 1);
+    start[0] = 0;
+}

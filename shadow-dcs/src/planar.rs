@@ -1,0 +1,311 @@
+//! The covered-sample test of DCS section 4.2 (Algorithm 1, lines 4-7) in the plane of a planar
+//! light, set up per (pixel, edge) in single precision from per-edge vectors prepared once.
+//!
+//! Around the light centre `c` (`x' = x - c`), with the light's in-plane axes `u` and `v`, a
+//! light sample is `s' = s_u u + s_v v`. The four orientation tests of [`EdgeTest`] (the edge
+//! `a b` crosses the triangle `(p, c, s)`) are then linear forms in `(s_u, s_v)`:
+//! * the sector sides `orient(p, c, s, a) ~ (p' x a') . s' = s_u p' . (a' x u) + s_v p' . (a' x v)`,
+//!   and the same with `b`;
+//! * the shadow-volume side `orient(a, b, c, s) ~ (a' x b') . s'`, the same for every pixel;
+//! * the edge side `orient(a, b, s, p) ~ (p' x e - a' x b') . s' + (a' x b') . p'` with
+//!   `e = b - a`.
+//!
+//! So a pair costs seven dot products with `p'` (the cross products of the edge with `u` and
+//! `v` are prepared per edge), and a sample four two-term forms. The covered cone's orientation
+//! is the sign of `orient(a, b, p, c) = -(a' x b') . p'`; where single precision cannot tell
+//! that sign (the edge's line passes within rounding of the line `p c`), it is taken from the
+//! double-precision [`CentredEdge`]. Two edges that share an end point evaluate the same sector
+//! form for it (same prepared vector, same `p'`), so the sectors of a silhouette chain tile the
+//! light without gap or overlap whatever the rounding. Agreement with the 3D form of
+//! [`EdgeTest`] up to rounding at ties is tested below.
+
+use glam::{DVec3, Vec2, Vec3, Vec4};
+
+use crate::centred::CentredEdge;
+use crate::edges::SceneEdge;
+
+/// Relative error bound of the orientation `(a' x b') . p'` in single precision, against
+/// `|a' x b'| . |p'|` (componentwise absolute values): the rounding of the prepared vector and
+/// of three products and two sums is below `1e-6` of it.
+const ORIENT_BOUND: f32 = 1e-5;
+
+/// One silhouette edge prepared for the light-plane test: the rows of the 3 x 8 matrix whose
+/// columns are `a' x u`, `a' x v`, `b' x u`, `b' x v`, `e x u`, `e x v`, `a' x b'` and zero,
+/// so that one matrix-vector product with `p'` gives all seven dot products.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PlanarEdge {
+    /// Row `x` (columns 0-3, then 4-7), row `y`, row `z`.
+    rows: [[f32; 4]; 6],
+    /// `((a' x b') . u, (a' x b') . v)`.
+    w1: Vec2,
+    /// `|a' x b'|`.
+    m_norm: f32,
+}
+
+impl PlanarEdge {
+    /// Edge `e` around the light centre `c` with in-plane axes `u`, `v`.
+    pub fn new(e: &SceneEdge, c: DVec3, u: DVec3, v: DVec3) -> Self {
+        let (a, b) = (e.a - c, e.b - c);
+        let d = b - a;
+        let m = a.cross(b);
+        let cols = [
+            a.cross(u),
+            a.cross(v),
+            b.cross(u),
+            b.cross(v),
+            d.cross(u),
+            d.cross(v),
+            m,
+            DVec3::ZERO,
+        ]
+        .map(|x| x.as_vec3());
+        let row =
+            |k: usize, half: usize| -> [f32; 4] { std::array::from_fn(|j| cols[4 * half + j][k]) };
+        Self {
+            rows: [
+                row(0, 0),
+                row(0, 1),
+                row(1, 0),
+                row(1, 1),
+                row(2, 0),
+                row(2, 1),
+            ],
+            w1: Vec2::new(m.dot(u) as f32, m.dot(v) as f32),
+            m_norm: m.length() as f32,
+        }
+    }
+
+    /// The test from the centred view sample `p` (length `p_norm`; `p_exact` in double
+    /// precision), `None` on the tie of [`EdgeTest::new`](crate::coverage::EdgeTest) (the
+    /// edge's line meets the line `p c`). `exact` gives the orientation when single precision
+    /// cannot.
+    #[inline]
+    pub fn test(
+        &self,
+        p: Vec3,
+        p_norm: f32,
+        exact: &CentredEdge,
+        p_exact: DVec3,
+    ) -> Option<PlanarTest> {
+        let (px, py, pz) = (Vec4::splat(p.x), Vec4::splat(p.y), Vec4::splat(p.z));
+        let r = |i: usize| Vec4::from(self.rows[i]);
+        // (p . a'xu, p . a'xv, p . b'xu, p . b'xv) and (p . exu, p . exv, p . a'xb', 0).
+        let lo = px * r(0) + py * r(2) + pz * r(4);
+        let hi = px * r(1) + py * r(3) + pz * r(5);
+        let mp = hi.z;
+        // The cone's orientation: `orient(a, b, p, c) = -mp` positive gives sign +1.
+        let positive = if mp.abs() > ORIENT_BOUND * self.m_norm * p_norm {
+            mp < 0.0
+        } else {
+            exact.orientation(p_exact)?
+        };
+        let s = if positive { 1.0 } else { -1.0 };
+        // a = -s (p . a'xu, p . a'xv), b = -s (p . b'xu, p . b'xv), w1 = s w1,
+        // h2 = s (p . exu - w1.x, p . exv - w1.y), k2 = s mp.
+        let ab = lo * -s;
+        let h2 = (hi - Vec4::new(self.w1.x, self.w1.y, 0.0, 0.0)) * s;
+        let w1 = self.w1 * s;
+        Some(PlanarTest {
+            cx: Vec4::new(ab.x, -ab.z, w1.x, h2.x),
+            cy: Vec4::new(ab.y, -ab.w, w1.y, h2.y),
+            c0: Vec4::new(0.0, 0.0, 0.0, h2.z),
+        })
+    }
+}
+
+/// The covered-sample test of one (pixel, edge) pair in the light plane: sample `s` (in-plane
+/// coordinates around the centre) is covered when `a . s > 0`, `b . s < 0`, `w1 . s > 0` and
+/// `h2 . s + k2 > 0`, stored as the four forms `cx s_x + cy s_y + c0`, all positive where
+/// covered.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PlanarTest {
+    /// `(a.x, -b.x, w1.x, h2.x)`.
+    cx: Vec4,
+    /// `(a.y, -b.y, w1.y, h2.y)`.
+    cy: Vec4,
+    /// `(0, 0, 0, k2)`.
+    c0: Vec4,
+}
+
+impl PlanarTest {
+    /// A placeholder that covers nothing.
+    pub const NONE: Self = Self {
+        cx: Vec4::ZERO,
+        cy: Vec4::ZERO,
+        c0: Vec4::ZERO,
+    };
+
+    /// The sector's sides: the covered cone is `a . s > 0`, `b . s < 0`.
+    #[inline]
+    pub fn sector(&self) -> (Vec2, Vec2) {
+        (
+            Vec2::new(self.cx.x, self.cy.x),
+            Vec2::new(-self.cx.y, -self.cy.y),
+        )
+    }
+
+    /// Whether the sample at in-plane coordinates `(x, y)` is covered.
+    #[inline(always)]
+    pub fn covers(&self, x: f32, y: f32) -> bool {
+        (self.cx * x + self.cy * y + self.c0)
+            .cmpgt(Vec4::ZERO)
+            .all()
+    }
+
+    /// The samples of the word `subset` (word `w` of `samples`) the edge covers.
+    #[inline]
+    pub fn covered_in(&self, samples: &PlanarSamples, w: usize, subset: u64) -> u64 {
+        let (mut todo, mut out) = (subset, 0u64);
+        while todo != 0 {
+            let k = todo.trailing_zeros() as usize;
+            todo &= todo - 1;
+            let i = w * 64 + k;
+            if self.covers(samples.x[i], samples.y[i]) {
+                out |= 1 << k;
+            }
+        }
+        out
+    }
+
+    /// The samples of word `w` of `samples` the edge covers (every sample tested, four at a
+    /// time).
+    pub fn covered_word(&self, samples: &PlanarSamples, w: usize) -> u64 {
+        let base = w * 64;
+        let (xs, _) = samples.x[base..base + 64].as_chunks::<4>();
+        let (ys, _) = samples.y[base..base + 64].as_chunks::<4>();
+        let f = |c: Vec4| -> [Vec4; 4] { [c.x, c.y, c.z, c.w].map(Vec4::splat) };
+        let (cx, cy, c0) = (f(self.cx), f(self.cy), self.c0.w);
+        let mut bits = 0u64;
+        for (q, (x, y)) in xs.iter().zip(ys).enumerate() {
+            let (x, y) = (Vec4::from(*x), Vec4::from(*y));
+            let va = cx[0] * x + cy[0] * y;
+            let vb = cx[1] * x + cy[1] * y;
+            let w1 = cx[2] * x + cy[2] * y;
+            let w2 = cx[3] * x + cy[3] * y + Vec4::splat(c0);
+            let all = va.cmpgt(Vec4::ZERO)
+                & vb.cmpgt(Vec4::ZERO)
+                & w1.cmpgt(Vec4::ZERO)
+                & w2.cmpgt(Vec4::ZERO);
+            bits |= u64::from(all.bitmask()) << (4 * q);
+        }
+        bits
+    }
+}
+
+/// A pixel's light samples in the light plane around the centre, structure of arrays, padded to
+/// whole 64-sample words.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct PlanarSamples {
+    pub x: Vec<f32>,
+    pub y: Vec<f32>,
+}
+
+impl PlanarSamples {
+    /// Sets the samples `positions` (world space) around `c` on axes `u`, `v`.
+    pub fn set(&mut self, positions: &[Vec3], c: Vec3, u: Vec3, v: Vec3) {
+        let padded = positions.len().div_ceil(64) * 64;
+        for w in [&mut self.x, &mut self.y] {
+            w.clear();
+            w.resize(padded, 0.0);
+        }
+        for (k, s) in positions.iter().enumerate() {
+            let d = *s - c;
+            self.x[k] = d.dot(u);
+            self.y[k] = d.dot(v);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::coverage::EdgeTest;
+    use crate::edges::EdgeFace;
+    use shadow_core::sampling::{hash_words, unit_float};
+
+    fn edge(a: DVec3, b: DVec3) -> SceneEdge {
+        let third = (a + b) * 0.5 + DVec3::new(0.0, 0.0, 0.1);
+        let normal = (b - a).cross(third - a);
+        SceneEdge {
+            a,
+            b,
+            faces: vec![EdgeFace {
+                third,
+                normal,
+                offset: -normal.dot(a),
+                weight: 1,
+                two_sided: true,
+            }],
+            always: true,
+        }
+    }
+
+    /// The light-plane test covers the samples the 3D test covers, up to rounding at ties, far
+    /// from the origin too; and it gives the same sector sides to two edges sharing an end.
+    #[test]
+    fn light_plane_test_equals_the_3d_test() {
+        let (mut compared, mut differ, mut covered) = (0u64, 0u64, 0u64);
+        for k in 0..4000u64 {
+            let r = |i: u64| unit_float(hash_words(&[k, i])) as f64 * 2.0 - 1.0;
+            let offset = DVec3::splat([0.0, 1e3, 1e5][k as usize % 3]);
+            // A light tilted by case, its centre, axes and a half size.
+            let n = DVec3::new(r(20) * 0.3, -1.0, r(21) * 0.3).normalize();
+            let u = n.any_orthonormal_vector();
+            let v = n.cross(u);
+            let c = offset + DVec3::new(r(0), 3.0 + r(1), r(2));
+            let p = offset + DVec3::new(r(3) * 2.0, 0.1 * r(4), r(5) * 2.0);
+            let mid = offset + DVec3::new(r(6), 1.5 + r(7), r(8));
+            let dir = DVec3::new(r(9), r(10) * 0.3, r(11)) * 0.3;
+            let (a, b) = (mid - dir, mid + dir);
+            let e = edge(a, b);
+            let centred = CentredEdge::new(&e, c);
+            let planar = PlanarEdge::new(&e, c, u, v);
+            let pc = p - c;
+            let (Some(t3), Some(t2)) = (
+                EdgeTest::new(p, c, a, b),
+                planar.test(pc.as_vec3(), pc.length() as f32, &centred, pc),
+            ) else {
+                continue;
+            };
+            for j in 0..64 {
+                let (x, y) = (r(30 + 2 * j) * 0.8, r(31 + 2 * j) * 0.8);
+                let s = c + u * x + v * y;
+                let want = t3.covers_offset((s - p).as_vec3());
+                let got = t2.covers(x as f32, y as f32);
+                compared += 1;
+                covered += u64::from(want);
+                differ += u64::from(want != got);
+            }
+            // A neighbouring edge from b: its sector side at b is the same form.
+            let e2 = edge(b, b + DVec3::new(r(12), 0.1 * r(13), r(14)) * 0.3);
+            let t22 = PlanarEdge::new(&e2, c, u, v).test(
+                pc.as_vec3(),
+                pc.length() as f32,
+                &CentredEdge::new(&e2, c),
+                pc,
+            );
+            if let Some(t22) = t22 {
+                let (a2, _) = t22.sector();
+                let (_, b1) = t2.sector();
+                assert!(
+                    a2 == b1 || a2 == -b1,
+                    "case {k}: shared end point, different sector sides"
+                );
+            }
+            // Every sample of a word at once gives the same answer as one by one.
+            let mut samples = PlanarSamples::default();
+            let pos: Vec<Vec3> = (0..64)
+                .map(|j| (c + u * r(30 + 2 * j) * 0.8 + v * r(31 + 2 * j) * 0.8).as_vec3())
+                .collect();
+            samples.set(&pos, c.as_vec3(), u.as_vec3(), v.as_vec3());
+            assert_eq!(
+                t2.covered_word(&samples, 0),
+                t2.covered_in(&samples, 0, u64::MAX),
+                "case {k}"
+            );
+        }
+        assert!(covered > 2000, "{covered}");
+        assert!(differ * 100_000 <= compared, "{differ} of {compared}");
+        eprintln!("{differ} of {compared}");
+    }
+}
