@@ -14,7 +14,7 @@
 //! ([`AngularIndex::candidates_batch`]): each step of the sectors' arithmetic is a loop over
 //! the batch, which the compiler turns into packed instructions.
 
-use glam::{Vec3, Vec4};
+use glam::{Mat4, Vec3, Vec4};
 
 use crate::coverage::EdgeTest;
 use crate::light_shape::LightPlane;
@@ -112,6 +112,20 @@ impl AngularIndex {
                     *x |= *below;
                 }
             }
+        }
+    }
+
+    /// The samples that may lie in sector `j` of `r`, for a pixel with one word of samples.
+    #[inline(always)]
+    pub fn quad_word(&self, r: &QuadRanges, j: usize) -> u64 {
+        if r.narrow >> j & 1 == 0 {
+            return u64::MAX;
+        }
+        let (below_lo, upto_hi) = (self.prefix[r.lo[j]], self.prefix[r.hi[j] + 1]);
+        if r.wraps >> j & 1 == 1 {
+            upto_hi | !below_lo
+        } else {
+            upto_hi & !below_lo
         }
     }
 
@@ -250,13 +264,12 @@ impl QuadRanges {
     /// The ranges of four light-plane tests' sectors.
     #[inline]
     pub fn of_tests(tests: &[PlanarTest; 4]) -> Self {
-        let sides = tests.map(|t| t.sector());
-        Self::of(
-            Vec4::from_array(sides.map(|s| s.0.x)),
-            Vec4::from_array(sides.map(|s| s.0.y)),
-            Vec4::from_array(sides.map(|s| s.1.x)),
-            Vec4::from_array(sides.map(|s| s.1.y)),
-        )
+        // The tests' x coefficients as columns: their rows are `a.x` and `-b.x` of every
+        // test; the same for y.
+        let c = tests.map(|t| t.coefficients());
+        let xs = Mat4::from_cols(c[0].0, c[1].0, c[2].0, c[3].0).transpose();
+        let ys = Mat4::from_cols(c[0].1, c[1].1, c[2].1, c[3].1).transpose();
+        Self::of(xs.x_axis, ys.x_axis, -xs.y_axis, -ys.y_axis)
     }
 
     /// The ranges of the cones `a . d > 0`, `b . d < 0` given lane by lane.

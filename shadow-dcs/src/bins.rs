@@ -23,9 +23,11 @@
 
 use glam::{BVec4A, DVec3, Vec3, Vec4};
 
-use crate::centred::CentredPlane;
+use crate::centred::FastWeight;
+use crate::centred::{CentredEdge, CentredPlane};
 use crate::edges::SceneEdge;
-use crate::lanes::{TILE_H, TILE_W, TileLanes, TileQuads, lanes_of, rect_lanes};
+use crate::lanes::{LANES, LaneMask, TILE_H, TILE_W, TileLanes, TileQuads, lanes_of, rect_lanes};
+use crate::planar::{PlanarEdge, PlanarTest};
 use crate::wedges::{Pair, Wedge};
 
 /// Side of a block, in pixels (a multiple of [`SQUARE`]).
@@ -50,16 +52,25 @@ type BoxPlane = [f32; 7];
 /// The plane every box passes (`0 . x + 1 >= 0`): unused plane slots.
 const OPEN: BoxPlane = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
 
-/// A wedge's bounding planes and the planes of its edge's two faces, for box tests.
+/// Everything the wedge scan reads of one wedge, in one place (the scan visits wedges in
+/// silhouette order, square by square): its bounding planes and the planes of its edge's two
+/// faces for box tests (the bounding planes also test view samples), its weight from plane
+/// signs, and its edge prepared for the light-plane test.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct WedgeBox {
+pub(crate) struct ScanWedge {
     planes: [BoxPlane; BOX_PLANES],
+    /// Bounding planes in use (the rest are open).
+    used: usize,
     fold: [BoxPlane; 2],
+    weight: Option<FastWeight>,
+    planar: Option<PlanarEdge>,
+    /// The scene edge.
+    edge: u32,
 }
 
-impl WedgeBox {
-    /// The box-test data of wedge `w`.
-    pub fn of(w: &Wedge) -> Self {
+impl ScanWedge {
+    /// The scan data of wedge `w`, with its edge in light-plane form for planar lights.
+    pub fn new(w: &Wedge, planar: Option<PlanarEdge>) -> Self {
         let plane = |p: &CentredPlane| -> BoxPlane {
             let (n, d) = p.coefficients();
             [n.x, n.y, n.z, d, n.x.abs(), n.y.abs(), n.z.abs()]
@@ -71,8 +82,30 @@ impl WedgeBox {
         };
         Self {
             planes: std::array::from_fn(|k| w.planes.get(k).map_or(OPEN, plane)),
+            used: w.planes.len().min(BOX_PLANES),
             fold,
+            weight: w.weight,
+            planar,
+            edge: w.edge,
         }
+    }
+
+    /// The view samples of `lanes` that no bounding plane puts on its negative side (a NaN
+    /// value rejects nothing); stops when no view sample is left.
+    #[inline]
+    fn inside(&self, t: &TileQuads, lanes: LaneMask) -> LaneMask {
+        let mut alive = lanes;
+        for p in &self.planes[..self.used] {
+            if alive == 0 {
+                break;
+            }
+            let [nx, ny, nz, d] = [p[0], p[1], p[2], p[3]].map(Vec4::splat);
+            for q in 0..4 {
+                let v = nx * t.x[q] + ny * t.y[q] + nz * t.z[q] + d;
+                alive &= !((v.cmplt(Vec4::ZERO).bitmask() as LaneMask) << (4 * q));
+            }
+        }
+        alive
     }
 }
 
@@ -118,7 +151,7 @@ impl Boxes {
     /// the whole box on its negative side, and the fold planes do not both surely differ in
     /// sign over it (a NaN keeps the box). `slack` is the fold test's slack.
     #[inline]
-    pub fn test(&self, w: &WedgeBox, slack: f32) -> u64 {
+    pub fn test(&self, w: &ScanWedge, slack: f32) -> u64 {
         let quads = self.m[0].len().min(BOXES / 4);
         let [m0, m1, m2] = [
             &self.m[0][..quads],
@@ -131,7 +164,7 @@ impl Boxes {
             &self.h[2][..quads],
         ];
         let mut reject = [BVec4A::splat(false); BOXES / 4];
-        for p in &w.planes {
+        for p in &w.planes[..w.used] {
             let [nx, ny, nz, d, ax, ay, az] = p.map(Vec4::splat);
             for q in 0..quads {
                 let v = nx * m0[q]
@@ -236,14 +269,23 @@ pub(crate) fn rect_box(
     b
 }
 
-/// The (pixel, edge, weight) pairs of a square, grouped by pixel in edge order (CSR).
+/// The (pixel, edge, weight) pairs of a square, grouped by pixel (CSR). Pixels are numbered
+/// tile by tile (row by row of tiles), then lane by lane within a tile, so that each tile's
+/// pairs are grouped on their own.
 #[derive(Debug, Default)]
 pub(crate) struct SquarePairs {
     rect: Option<Rect>,
-    /// `start[j]..start[j + 1]` indexes the entries of the square's pixel `j` (row by row).
+    /// Tiles per row of tiles.
+    across: usize,
+    /// `start[j]..start[j + 1]` indexes the entries of the square's pixel `j`.
     start: Vec<u32>,
     /// The pairs, by pixel.
     entries: Vec<Pair>,
+    /// With the light-plane test, each pair's test (same order as `entries`; a placeholder
+    /// that covers nothing for a pixel that takes the 3D test).
+    tests: Vec<PlanarTest>,
+    /// Pairs dropped on the tie of the light-plane test's orientation.
+    pub ties: u64,
     /// View samples tested against a wedge's planes and weight.
     pub scanned: u64,
     /// (tile, wedge) candidates evaluated on the tile's view samples.
@@ -253,11 +295,27 @@ pub(crate) struct SquarePairs {
 }
 
 impl SquarePairs {
-    /// The entries of the pixel at column `x`, row `y` (inside the square).
-    pub fn of(&self, x: u32, y: u32) -> &[Pair] {
+    /// The square's pixels inside the image: `(j, x, y)` with `j` the pixel's number.
+    pub fn pixels(&self) -> impl Iterator<Item = (usize, u32, u32)> + '_ {
         let r = self.rect.expect("pairs of a square");
-        let j = ((y - r.rows.0) * r.width() + (x - r.cols.0)) as usize;
-        &self.entries[self.start[j] as usize..self.start[j + 1] as usize]
+        let across = self.across;
+        (0..self.start.len() - 1).filter_map(move |j| {
+            let (t, lane) = (j / LANES, j % LANES);
+            let x = r.cols.0 + (t % across) as u32 * TILE_W + (lane as u32 % TILE_W);
+            let y = r.rows.0 + (t / across) as u32 * TILE_H + (lane as u32 / TILE_W);
+            (x <= r.cols.1 && y <= r.rows.1).then_some((j, x, y))
+        })
+    }
+
+    /// The entries of pixel number `j`, and their light-plane tests (empty without).
+    pub fn of(&self, j: usize) -> (&[Pair], &[PlanarTest]) {
+        let range = self.start[j] as usize..self.start[j + 1] as usize;
+        let tests = if self.tests.is_empty() {
+            &[][..]
+        } else {
+            &self.tests[range.clone()]
+        };
+        (&self.entries[range], tests)
     }
 
     /// Number of pairs.
@@ -270,15 +328,19 @@ impl SquarePairs {
 #[derive(Default)]
 pub(crate) struct SquareScratch {
     tiles: Boxes,
-    found: Vec<(u32, Pair)>,
+    /// Each tile's wedges.
+    lists: Vec<Vec<u32>>,
+    /// A tile's pairs as found: lane, pair, test.
+    found: Vec<(u8, Pair)>,
+    found_tests: Vec<PlanarTest>,
+    order: Vec<u32>,
     lanes: Vec<TileLanes>,
 }
 
 /// What the wedge scan reads of a frame.
 pub(crate) struct ScanInput<'a> {
     pub edges: &'a [SceneEdge],
-    pub wedges: &'a [Wedge],
-    pub boxes: &'a [WedgeBox],
+    pub wedges: &'a [ScanWedge],
     /// The light centre.
     pub c: DVec3,
     pub width: u32,
@@ -287,11 +349,17 @@ pub(crate) struct ScanInput<'a> {
     pub active: &'a [bool],
     /// Slack of the fold test.
     pub slack: f32,
+    /// With the light-plane form of the covered-sample test: the silhouette edges around the
+    /// light centre (for its orientation ties) and the pixels that take it (the others take
+    /// the 3D test).
+    pub planar: Option<(&'a [CentredEdge], &'a [bool])>,
 }
 
 /// The pairs of square `rect` from the wedges its box keeps (`wedges`, silhouette indices in
-/// order): each tile's box, then the tile's view samples (exact weight where the
-/// single-precision signs are uncertain).
+/// order): every wedge against the boxes of the square's tiles, then tile by tile, each of its
+/// wedges on the tile's view samples (weight first, exact where the single-precision signs are
+/// uncertain, then the bounding planes), with the light-plane test set up while the wedge is
+/// at hand.
 pub(crate) fn square_pairs(
     input: &ScanInput,
     wedges: &[u32],
@@ -299,20 +367,23 @@ pub(crate) fn square_pairs(
     out: &mut SquarePairs,
     scratch: &mut SquareScratch,
 ) {
-    let n = rect.len();
     out.rect = Some(rect);
     out.entries.clear();
+    out.tests.clear();
     out.start.clear();
-    out.start.resize(n + 1, 0);
+    out.start.push(0);
     out.scanned = 0;
     out.tile_wedges = 0;
     out.square_wedges = wedges.len() as u64;
+    out.ties = 0;
     let SquareScratch {
         tiles,
+        lists,
         found,
+        found_tests,
+        order,
         lanes,
     } = scratch;
-    found.clear();
     let across = rect_lanes(
         input.width,
         rect.cols,
@@ -321,65 +392,99 @@ pub(crate) fn square_pairs(
         input.active,
         lanes,
     );
+    out.across = across;
     tiles.set(lanes.iter().map(TileLanes::bounds));
-    let quads: Vec<TileQuads> = lanes.iter().map(TileLanes::quads).collect();
-    let w = input.width as usize;
-    let sw = rect.width();
+    lists.resize(lanes.len(), Vec::new());
+    for l in lists.iter_mut() {
+        l.clear();
+    }
     for &wi in wedges {
-        let wedge = &input.wedges[wi as usize];
-        let mask = tiles.test(&input.boxes[wi as usize], input.slack);
+        let mask = tiles.test(&input.wedges[wi as usize], input.slack);
         out.tile_wedges += u64::from(mask.count_ones());
         for t in bits_of(mask) {
-            let tile = &lanes[t];
+            lists[t].push(wi);
+        }
+    }
+    let w = input.width as usize;
+    for (t, (tile, list)) in lanes.iter().zip(lists.iter()).enumerate() {
+        let quads = tile.quads();
+        let x0 = rect.cols.0 + (t % across) as u32 * TILE_W;
+        let y0 = rect.rows.0 + (t / across) as u32 * TILE_H;
+        found.clear();
+        found_tests.clear();
+        for &wi in list {
+            let wedge = &input.wedges[wi as usize];
             out.scanned += u64::from(tile.active.count_ones());
-            let inside = CentredPlane::inside_all(&wedge.planes, &quads[t], tile.active);
-            if inside == 0 {
-                continue;
-            }
-            let x0 = rect.cols.0 + (t % across) as u32 * TILE_W;
-            let y0 = rect.rows.0 + (t / across) as u32 * TILE_H;
-            let e = &input.edges[wedge.edge as usize];
-            let fast = wedge
-                .weight
-                .as_ref()
-                .and_then(|f| f.weight_lanes(&quads[t], inside));
+            // The weight first (it rejects more view samples than the planes), then the planes
+            // on the view samples left.
+            let fast = wedge.weight.as_ref().and_then(|f| f.weight_lanes(&quads));
+            let candidates = match &fast {
+                Some(f) => tile.active & (f.nonzero | !f.certain),
+                None => tile.active,
+            };
+            let inside = wedge.inside(&quads, candidates);
             for j in lanes_of(inside) {
-                let (x, y) = (x0 + j as u32 % TILE_W, y0 + j as u32 / TILE_W);
+                let i = (y0 + j as u32 / TILE_W) as usize * w + (x0 + j as u32 % TILE_W) as usize;
                 let k = match &fast {
-                    Some(f) if f.certain >> j & 1 == 1 => i64::from(f.k[j]),
+                    Some(f) if f.certain >> j & 1 == 1 => f.k(j),
                     _ => {
-                        let o = input.origins[y as usize * w + x as usize].as_dvec3();
-                        match e.sweep_weight(o, input.c, false) {
+                        let e = &input.edges[wedge.edge as usize];
+                        match e.sweep_weight(input.origins[i].as_dvec3(), input.c, false) {
                             Some(k) => k,
                             None => continue,
                         }
                     }
                 };
-                if k != 0 {
-                    let k = k.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
-                    let local = (y - rect.rows.0) * sw + (x - rect.cols.0);
-                    found.push((local, Pair { edge: wi, k }));
+                if k == 0 {
+                    continue;
                 }
+                if let Some((centred_edges, pixels)) = input.planar {
+                    let test = match (&wedge.planar, pixels[i]) {
+                        (Some(pe), true) => {
+                            let exact = || {
+                                let pc = input.origins[i].as_dvec3() - input.c;
+                                centred_edges[wi as usize].orientation(pc)
+                            };
+                            match pe.test(input.centred[i], tile.l1[j], exact) {
+                                Some(t) => t,
+                                None => {
+                                    out.ties += 1;
+                                    continue;
+                                }
+                            }
+                        }
+                        _ => PlanarTest::NONE,
+                    };
+                    found_tests.push(test);
+                }
+                let k = k.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+                found.push((j as u8, Pair { edge: wi, k }));
             }
         }
+        // The tile's pairs lane by lane, each lane's in wedge order.
+        let mut count = [0u32; LANES];
+        for (j, _) in found.iter() {
+            count[*j as usize] += 1;
+        }
+        let mut at = [0u32; LANES];
+        let mut sum = 0;
+        for j in 0..LANES {
+            at[j] = sum;
+            sum += count[j];
+            out.start.push(out.entries.len() as u32 + sum);
+        }
+        order.clear();
+        order.resize(found.len(), 0);
+        for (f, (j, _)) in found.iter().enumerate() {
+            let slot = &mut at[*j as usize];
+            order[*slot as usize] = f as u32;
+            *slot += 1;
+        }
+        out.entries
+            .extend(order.iter().map(|&f| found[f as usize].1));
+        if !found_tests.is_empty() {
+            out.tests
+                .extend(order.iter().map(|&f| found_tests[f as usize]));
+        }
     }
-    // Counting sort by pixel, stable: each pixel's pairs stay in wedge order. `start[j + 1]`
-    // first counts pixel `j`'s pairs; after the running sum, `start[j]` is pixel `j`'s fill
-    // position, which ends at the start of pixel `j + 1`.
-    let start = &mut out.start;
-    for (j, _) in found.iter() {
-        start[*j as usize + 1] += 1;
-    }
-    for j in 0..n {
-        start[j + 1] += start[j];
-    }
-    out.entries.resize(found.len(), Pair { edge: 0, k: 0 });
-    for (j, pair) in found.iter() {
-        let slot = &mut start[*j as usize];
-        out.entries[*slot as usize] = *pair;
-        *slot += 1;
-    }
-    // Each `start[j]` now holds the start of pixel `j + 1`: shift back.
-    start.copy_within(0..n, 1);
-    start[0] = 0;
 }

@@ -18,7 +18,7 @@ use glam::{DVec3, Vec3, Vec4};
 
 use crate::coverage::EdgeTest;
 use crate::edges::SceneEdge;
-use crate::lanes::{LANES, LaneMask, TileQuads, lanes_of};
+use crate::lanes::{LANES, LaneMask, TileQuads};
 
 /// Relative error bound of an `f32` plane evaluation, against `|n|_1 |x'|_1 + |d|`. The value
 /// carries the rounding of `n` and `d` to `f32` (one unit in the last place, `6e-8`, each), of
@@ -84,23 +84,6 @@ impl CentredPlane {
         }
         m
     }
-
-    /// The lanes of `lanes` that no plane of `planes` puts on its negative side (a NaN value
-    /// rejects nothing, as in a scalar `eval(x) < 0` test); stops when no lane is left.
-    #[inline]
-    pub fn inside_all(planes: &[Self], t: &TileQuads, lanes: LaneMask) -> LaneMask {
-        let mut alive = lanes;
-        for p in planes {
-            if alive == 0 {
-                break;
-            }
-            let v = p.eval_quads(t);
-            for q in 0..4 {
-                alive &= !((v[q].cmplt(Vec4::ZERO).bitmask() as LaneMask) << (4 * q));
-            }
-        }
-        alive
-    }
 }
 
 /// One adjacent face of an edge for the fast weight.
@@ -150,65 +133,84 @@ impl FastWeight {
     }
 }
 
-/// `k_e` at the requested lanes of a tile, with the mask of those lanes whose signs are all
-/// certain; lanes outside it must take the exact weight. Face weights are at most
-/// [`LANE_WEIGHT_MAX`], so that a lane's sum cannot overflow.
+/// `k_e` at every lane of a tile, with the mask of lanes whose signs are all certain (lanes
+/// outside it must take the exact weight) and the mask of lanes where it is not zero. Face
+/// weights are at most [`LANE_WEIGHT_MAX`], so that a lane's sum is exact in single precision.
 pub(crate) struct LaneWeights {
-    pub k: [i32; LANES],
+    k: [f32; LANES],
     pub certain: LaneMask,
+    pub nonzero: LaneMask,
 }
 
-/// The largest face weight the lane form takes (larger ones go through the exact weight).
-const LANE_WEIGHT_MAX: i64 = 1 << 29;
+impl LaneWeights {
+    /// `k_e` at lane `j`.
+    #[inline]
+    pub fn k(&self, j: usize) -> i64 {
+        self.k[j] as i64
+    }
+}
+
+/// The largest face weight the lane form takes (larger ones go through the exact weight): two
+/// of them add up exactly in single precision.
+const LANE_WEIGHT_MAX: i64 = 1 << 22;
 
 /// The mask of lanes where a lane quad comparison holds.
 #[inline(always)]
-fn mask_of(v: &[Vec4; 4], f: impl Fn(Vec4) -> glam::BVec4A) -> LaneMask {
+fn mask_of(v: &[glam::BVec4A; 4]) -> LaneMask {
     let mut m = 0;
-    for q in 0..4 {
-        m |= (f(v[q]).bitmask() as LaneMask) << (4 * q);
+    for (q, b) in v.iter().enumerate() {
+        m |= (b.bitmask() as LaneMask) << (4 * q);
     }
     m
 }
 
 impl FastWeight {
-    /// `k_e` at the lanes `lanes` of a tile by the rule of [`SceneEdge::sweep_weight`] from a
-    /// view sample toward `c`: that rule's side of `c` is the sign of `-N_c . (x - a)` and a
-    /// face's side that of `-N_f . (x - a)`; a one-sided face counts only from behind. `None`
-    /// when a face weight exceeds [`LANE_WEIGHT_MAX`].
+    /// `k_e` at every lane of a tile by the rule of [`SceneEdge::sweep_weight`] from a view
+    /// sample toward `c`: that rule's side of `c` is the sign of `-N_c . (x - a)` and a face's
+    /// side that of `-N_f . (x - a)`; a one-sided face counts only from behind. Four lanes at a
+    /// time in packed single precision (the weights are whole numbers well inside its range).
+    /// `None` when a face weight exceeds [`LANE_WEIGHT_MAX`].
     #[inline]
-    pub fn weight_lanes(&self, t: &TileQuads, lanes: LaneMask) -> Option<LaneWeights> {
+    pub fn weight_lanes(&self, t: &TileQuads) -> Option<LaneWeights> {
+        let zero = Vec4::ZERO;
         let v = self.through_center.eval_quads(t);
-        let mut certain = self.through_center.certain_quads(t, &v) & lanes;
-        let from_negative = mask_of(&v, |x| x.cmplt(Vec4::ZERO));
-        // Per face: the lanes where it counts and where the sweep moves onto its side.
-        let mut faces = [(0 as LaneMask, 0 as LaneMask, 0i32); 2];
-        for (slot, f) in faces.iter_mut().zip(self.faces.iter().flatten()) {
+        let mut certain = self.through_center.certain_quads(t, &v);
+        let from_negative = v.map(|x| x.cmplt(zero));
+        let mut k = [zero; 4];
+        for f in self.faces.iter().flatten() {
             if f.weight > LANE_WEIGHT_MAX {
                 return None;
             }
+            let w = Vec4::splat(f.weight as f32);
             let v = f.plane.eval_quads(t);
             certain &= f.plane.certain_quads(t, &v);
-            let positive = mask_of(&v, |x| x.cmpgt(Vec4::ZERO));
-            let negative = mask_of(&v, |x| x.cmplt(Vec4::ZERO));
-            let front = if f.front_positive {
-                positive
-            } else {
-                !positive
-            };
-            let counts = if f.two_sided { LaneMask::MAX } else { !front };
-            let same = !(negative ^ from_negative);
-            *slot = (counts, same, f.weight as i32);
-        }
-        let mut k = [0i32; LANES];
-        for j in lanes_of(lanes) {
-            for &(counts, same, w) in &faces {
-                if counts >> j & 1 == 1 {
-                    k[j] += if same >> j & 1 == 1 { -w } else { w };
-                }
+            for q in 0..4 {
+                let positive = v[q].cmpgt(zero);
+                let front = if f.front_positive {
+                    positive
+                } else {
+                    !positive
+                };
+                // Moving off the face's side (same side as the centre's) subtracts its weight.
+                let same = !(v[q].cmplt(zero) ^ from_negative[q]);
+                let signed = Vec4::select(same, -w, w);
+                k[q] += if f.two_sided {
+                    signed
+                } else {
+                    Vec4::select(front, zero, signed)
+                };
             }
         }
-        Some(LaneWeights { k, certain })
+        let nonzero = mask_of(&k.map(|x| x.cmpne(zero)));
+        let mut out = [0.0f32; LANES];
+        for q in 0..4 {
+            out[4 * q..4 * q + 4].copy_from_slice(&k[q].to_array());
+        }
+        Some(LaneWeights {
+            k: out,
+            certain,
+            nonzero,
+        })
     }
 }
 
@@ -351,14 +353,14 @@ mod tests {
             let tile = tiles[0];
             let lanes = FastWeight::new(&edge, c)
                 .unwrap()
-                .weight_lanes(&tile.quads(), tile.active)
+                .weight_lanes(&tile.quads())
                 .unwrap();
             for (j, p) in points.iter().enumerate() {
                 total += 1;
                 if lanes.certain >> j & 1 == 1 {
                     certain += 1;
                     assert_eq!(
-                        Some(i64::from(lanes.k[j])),
+                        Some(lanes.k(j)),
                         edge.sweep_weight(*p, c, false),
                         "case {k} lane {j}"
                     );
@@ -382,10 +384,10 @@ mod tests {
             let pc = (p - c).as_vec3();
             let fast = FastWeight::new(&edge, c).unwrap();
             total += 1;
-            let lanes = fast.weight_lanes(&TileLanes::at(pc).quads(), 1).unwrap();
+            let lanes = fast.weight_lanes(&TileLanes::at(pc).quads()).unwrap();
             if lanes.certain & 1 == 1 {
                 answered += 1;
-                let k = i64::from(lanes.k[0]);
+                let k = lanes.k(0);
                 assert_eq!(Some(k), edge.sweep_weight(p, c, false), "case {k}");
             }
             let centred = CentredEdge::new(&edge, c);

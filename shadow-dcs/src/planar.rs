@@ -19,9 +19,8 @@
 //! light without gap or overlap whatever the rounding. Agreement with the 3D form of
 //! [`EdgeTest`] up to rounding at ties is tested below.
 
-use glam::{DVec3, Vec2, Vec3, Vec4};
+use glam::{DVec3, Vec3, Vec4};
 
-use crate::centred::CentredEdge;
 use crate::edges::SceneEdge;
 
 /// Relative error bound of the orientation `(a' x b') . p'` in single precision, against
@@ -29,17 +28,19 @@ use crate::edges::SceneEdge;
 /// of three products and two sums is below `1e-6` of it.
 const ORIENT_BOUND: f32 = 1e-5;
 
-/// One silhouette edge prepared for the light-plane test: the rows of the 3 x 8 matrix whose
-/// columns are `a' x u`, `a' x v`, `b' x u`, `b' x v`, `e x u`, `e x v`, `a' x b'` and zero,
-/// so that one matrix-vector product with `p'` gives all seven dot products.
+/// One silhouette edge prepared for the light-plane test, so that the test's forms come out of
+/// two small matrix-vector products with `p'` (no lane shuffles):
+/// `cx = s (p' . [-a'xu, b'xu, 0, exu] + [0, 0, w1.u, -w1.u])`, the same with `v` for `cy`, and
+/// `k2 = s (a'xb') . p'`, with `s` the cone's orientation.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct PlanarEdge {
-    /// Row `x` (columns 0-3, then 4-7), row `y`, row `z`.
+    /// The x, y and z rows of the `cx` matrix, then of the `cy` matrix.
     rows: [[f32; 4]; 6],
-    /// `((a' x b') . u, (a' x b') . v)`.
-    w1: Vec2,
-    /// `|a' x b'|`.
-    m_norm: f32,
+    /// The constant parts of `cx` and `cy`.
+    kx: [f32; 4],
+    ky: [f32; 4],
+    /// `a' x b'` and its length.
+    m: [f32; 4],
 }
 
 impl PlanarEdge {
@@ -48,67 +49,53 @@ impl PlanarEdge {
         let (a, b) = (e.a - c, e.b - c);
         let d = b - a;
         let m = a.cross(b);
-        let cols = [
-            a.cross(u),
-            a.cross(v),
-            b.cross(u),
-            b.cross(v),
-            d.cross(u),
-            d.cross(v),
-            m,
-            DVec3::ZERO,
-        ]
-        .map(|x| x.as_vec3());
-        let row =
-            |k: usize, half: usize| -> [f32; 4] { std::array::from_fn(|j| cols[4 * half + j][k]) };
+        let (w1u, w1v) = (m.dot(u) as f32, m.dot(v) as f32);
+        let cols =
+            |w: DVec3| [-a.cross(w), b.cross(w), DVec3::ZERO, d.cross(w)].map(|x| x.as_vec3());
+        let (cu, cv) = (cols(u), cols(v));
+        let row = |c: &[Vec3; 4], k: usize| -> [f32; 4] { std::array::from_fn(|j| c[j][k]) };
         Self {
             rows: [
-                row(0, 0),
-                row(0, 1),
-                row(1, 0),
-                row(1, 1),
-                row(2, 0),
-                row(2, 1),
+                row(&cu, 0),
+                row(&cu, 1),
+                row(&cu, 2),
+                row(&cv, 0),
+                row(&cv, 1),
+                row(&cv, 2),
             ],
-            w1: Vec2::new(m.dot(u) as f32, m.dot(v) as f32),
-            m_norm: m.length() as f32,
+            kx: [0.0, 0.0, w1u, -w1u],
+            ky: [0.0, 0.0, w1v, -w1v],
+            m: [m.x as f32, m.y as f32, m.z as f32, m.length() as f32],
         }
     }
 
-    /// The test from the centred view sample `p` (length `p_norm`; `p_exact` in double
-    /// precision), `None` on the tie of [`EdgeTest::new`](crate::coverage::EdgeTest) (the
-    /// edge's line meets the line `p c`). `exact` gives the orientation when single precision
-    /// cannot.
-    #[inline]
+    /// The test from the centred view sample `p` (`p_norm` at least its length), `None` on the
+    /// tie of [`EdgeTest::new`](crate::coverage::EdgeTest) (the edge's line meets the line
+    /// `p c`). `exact` gives the orientation (`Some(orient(a, b, p, c) > 0)`, `None` on the
+    /// tie) when single precision cannot tell it.
+    #[inline(always)]
     pub fn test(
         &self,
         p: Vec3,
         p_norm: f32,
-        exact: &CentredEdge,
-        p_exact: DVec3,
+        exact: impl FnOnce() -> Option<bool>,
     ) -> Option<PlanarTest> {
-        let (px, py, pz) = (Vec4::splat(p.x), Vec4::splat(p.y), Vec4::splat(p.z));
-        let r = |i: usize| Vec4::from(self.rows[i]);
-        // (p . a'xu, p . a'xv, p . b'xu, p . b'xv) and (p . exu, p . exv, p . a'xb', 0).
-        let lo = px * r(0) + py * r(2) + pz * r(4);
-        let hi = px * r(1) + py * r(3) + pz * r(5);
-        let mp = hi.z;
+        let mp = self.m[0] * p.x + self.m[1] * p.y + self.m[2] * p.z;
         // The cone's orientation: `orient(a, b, p, c) = -mp` positive gives sign +1.
-        let positive = if mp.abs() > ORIENT_BOUND * self.m_norm * p_norm {
+        let positive = if mp.abs() > ORIENT_BOUND * self.m[3] * p_norm {
             mp < 0.0
         } else {
-            exact.orientation(p_exact)?
+            exact()?
         };
-        let s = if positive { 1.0 } else { -1.0 };
-        // a = -s (p . a'xu, p . a'xv), b = -s (p . b'xu, p . b'xv), w1 = s w1,
-        // h2 = s (p . exu - w1.x, p . exv - w1.y), k2 = s mp.
-        let ab = lo * -s;
-        let h2 = (hi - Vec4::new(self.w1.x, self.w1.y, 0.0, 0.0)) * s;
-        let w1 = self.w1 * s;
+        let s = Vec4::splat(if positive { 1.0 } else { -1.0 });
+        let (px, py, pz) = (Vec4::splat(p.x), Vec4::splat(p.y), Vec4::splat(p.z));
+        let r = |i: usize| Vec4::from(self.rows[i]);
+        let cx = (px * r(0) + py * r(1) + pz * r(2) + Vec4::from(self.kx)) * s;
+        let cy = (px * r(3) + py * r(4) + pz * r(5) + Vec4::from(self.ky)) * s;
         Some(PlanarTest {
-            cx: Vec4::new(ab.x, -ab.z, w1.x, h2.x),
-            cy: Vec4::new(ab.y, -ab.w, w1.y, h2.y),
-            c0: Vec4::new(0.0, 0.0, 0.0, h2.z),
+            cx,
+            cy,
+            k2: if positive { mp } else { -mp },
         })
     }
 }
@@ -123,8 +110,8 @@ pub(crate) struct PlanarTest {
     cx: Vec4,
     /// `(a.y, -b.y, w1.y, h2.y)`.
     cy: Vec4,
-    /// `(0, 0, 0, k2)`.
-    c0: Vec4,
+    /// The constant of the last form.
+    k2: f32,
 }
 
 impl PlanarTest {
@@ -132,22 +119,45 @@ impl PlanarTest {
     pub const NONE: Self = Self {
         cx: Vec4::ZERO,
         cy: Vec4::ZERO,
-        c0: Vec4::ZERO,
+        k2: 0.0,
     };
 
     /// The sector's sides: the covered cone is `a . s > 0`, `b . s < 0`.
-    #[inline]
-    pub fn sector(&self) -> (Vec2, Vec2) {
+    #[cfg(test)]
+    pub fn sector(&self) -> (glam::Vec2, glam::Vec2) {
         (
-            Vec2::new(self.cx.x, self.cy.x),
-            Vec2::new(-self.cx.y, -self.cy.y),
+            glam::Vec2::new(self.cx.x, self.cy.x),
+            glam::Vec2::new(-self.cx.y, -self.cy.y),
         )
+    }
+
+    /// The forms' coefficients of `s_x` and of `s_y`: `(a, -b, w1, h2)` component by
+    /// component.
+    #[inline]
+    pub fn coefficients(&self) -> (Vec4, Vec4) {
+        (self.cx, self.cy)
+    }
+
+    /// The samples of `subset` (one word: `xs`, `ys` hold its 64 samples) the edge covers.
+    #[inline(always)]
+    pub fn covered_of(&self, xs: &[f32; 64], ys: &[f32; 64], subset: u64) -> u64 {
+        let c0 = Vec4::new(0.0, 0.0, 0.0, self.k2);
+        let (mut todo, mut out) = (subset, 0u64);
+        while todo != 0 {
+            let k = todo.trailing_zeros() as usize & 63;
+            todo &= todo - 1;
+            let v = self.cx * xs[k] + self.cy * ys[k] + c0;
+            if v.cmpgt(Vec4::ZERO).all() {
+                out |= 1 << k;
+            }
+        }
+        out
     }
 
     /// Whether the sample at in-plane coordinates `(x, y)` is covered.
     #[inline(always)]
     pub fn covers(&self, x: f32, y: f32) -> bool {
-        (self.cx * x + self.cy * y + self.c0)
+        (self.cx * x + self.cy * y + Vec4::new(0.0, 0.0, 0.0, self.k2))
             .cmpgt(Vec4::ZERO)
             .all()
     }
@@ -174,7 +184,7 @@ impl PlanarTest {
         let (xs, _) = samples.x[base..base + 64].as_chunks::<4>();
         let (ys, _) = samples.y[base..base + 64].as_chunks::<4>();
         let f = |c: Vec4| -> [Vec4; 4] { [c.x, c.y, c.z, c.w].map(Vec4::splat) };
-        let (cx, cy, c0) = (f(self.cx), f(self.cy), self.c0.w);
+        let (cx, cy, c0) = (f(self.cx), f(self.cy), self.k2);
         let mut bits = 0u64;
         for (q, (x, y)) in xs.iter().zip(ys).enumerate() {
             let (x, y) = (Vec4::from(*x), Vec4::from(*y));
@@ -201,6 +211,22 @@ pub(crate) struct PlanarSamples {
 }
 
 impl PlanarSamples {
+    /// The first 64 samples' in-plane `x` (the first word).
+    #[inline]
+    pub fn first_word_x(&self) -> &[f32; 64] {
+        self.x[..64]
+            .try_into()
+            .expect("samples are padded to whole words")
+    }
+
+    /// The first 64 samples' in-plane `y`.
+    #[inline]
+    pub fn first_word_y(&self) -> &[f32; 64] {
+        self.y[..64]
+            .try_into()
+            .expect("samples are padded to whole words")
+    }
+
     /// Sets the samples `positions` (world space) around `c` on axes `u`, `v`.
     pub fn set(&mut self, positions: &[Vec3], c: Vec3, u: Vec3, v: Vec3) {
         let padded = positions.len().div_ceil(64) * 64;
@@ -219,6 +245,7 @@ impl PlanarSamples {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::centred::CentredEdge;
     use crate::coverage::EdgeTest;
     use crate::edges::EdgeFace;
     use shadow_core::sampling::{hash_words, unit_float};
@@ -263,7 +290,7 @@ mod tests {
             let pc = p - c;
             let (Some(t3), Some(t2)) = (
                 EdgeTest::new(p, c, a, b),
-                planar.test(pc.as_vec3(), pc.length() as f32, &centred, pc),
+                planar.test(pc.as_vec3(), pc.length() as f32, || centred.orientation(pc)),
             ) else {
                 continue;
             };
@@ -278,12 +305,9 @@ mod tests {
             }
             // A neighbouring edge from b: its sector side at b is the same form.
             let e2 = edge(b, b + DVec3::new(r(12), 0.1 * r(13), r(14)) * 0.3);
-            let t22 = PlanarEdge::new(&e2, c, u, v).test(
-                pc.as_vec3(),
-                pc.length() as f32,
-                &CentredEdge::new(&e2, c),
-                pc,
-            );
+            let ce2 = CentredEdge::new(&e2, c);
+            let t22 = PlanarEdge::new(&e2, c, u, v)
+                .test(pc.as_vec3(), pc.length() as f32, || ce2.orientation(pc));
             if let Some(t22) = t22 {
                 let (a2, _) = t22.sector();
                 let (_, b1) = t2.sector();

@@ -39,7 +39,7 @@ use shadow_core::visibility::{PerSampleVisibility, PixelClass};
 
 use crate::angular::{AngularIndex, BATCH, QuadRanges};
 use crate::bins::{
-    BOXES, Boxes, Rect, ScanInput, SquarePairs, SquareScratch, WedgeBox, bits_of, rect_box,
+    BOXES, Boxes, Rect, ScanInput, ScanWedge, SquarePairs, SquareScratch, bits_of, rect_box,
     square_pairs,
 };
 use crate::centred::CentredEdge;
@@ -50,7 +50,7 @@ use crate::discrete::{CoveredSamples, DiscreteTables, LineMasks};
 use crate::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
 use crate::light_shape::LightShape;
 use crate::planar::{PlanarEdge, PlanarSamples, PlanarTest};
-use crate::wedges::{FOLD_SLACK, Pair, Wedge, wedges};
+use crate::wedges::{FOLD_SLACK, Pair, wedges};
 
 /// What per-sample visibility an estimate returns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -79,20 +79,17 @@ struct Prepared {
     polygon: Option<Vec<Vec3>>,
     /// The silhouette edges around the light centre (same indices as `silhouettes`).
     centred_edges: Vec<CentredEdge>,
-    /// The wedge of every silhouette edge (same indices), and their box-test data.
-    wedges: Vec<Wedge>,
-    boxes: Vec<WedgeBox>,
+    /// What the wedge scan reads of every silhouette edge's wedge (same indices).
+    scan: Vec<ScanWedge>,
     /// The light-plane form of the silhouette edges, for planar lights.
     planar: Option<PlanarLight>,
 }
 
-/// A planar light's frame and its silhouette edges prepared for the light-plane test
-/// ([`crate::planar`]).
+/// A planar light's frame, for the light-plane test ([`crate::planar`]).
 struct PlanarLight {
     u: Vec3,
     v: Vec3,
     normal: Vec3,
-    edges: Vec<PlanarEdge>,
 }
 
 /// Depth complexity sampling.
@@ -125,6 +122,9 @@ struct Frame<'a> {
     horizon: Vec<Horizon>,
     active: Vec<bool>,
     constants: Vec<i64>,
+    /// The pixels that take the light-plane form of the covered-sample test (planar lights,
+    /// exact covered samples, a receiver clear of the light's plane); empty without.
+    planar_ok: Vec<bool>,
     bits: u32,
     view: &'a ViewSamples,
 }
@@ -358,18 +358,27 @@ impl Dcs {
         let bits = self.forced_bits.unwrap_or_else(|| width_for(max_constant));
         stats.add("max-integration-constant", max_constant);
         stats.add("counter-bits", bits as u64);
-        stats.add("wedges", p.wedges.len() as u64);
+        stats.add("wedges", p.scan.len() as u64);
         let cd = p.shape.center.as_dvec3();
-        let centred = origins
+        let centred: Vec<Vec3> = origins
             .par_iter()
             .map(|o| (o.as_dvec3() - cd).as_vec3())
             .collect();
+        let planar_ok = match (&p.planar, self.covered) {
+            (Some(pl), CoveredSamples::Exact) => centred
+                .par_iter()
+                .zip(&active)
+                .map(|(x, a)| *a && x.dot(pl.normal).abs() > NEAR_PLANE * x.length())
+                .collect(),
+            _ => Vec::new(),
+        };
         Ok(Frame {
             origins,
             centred,
             horizon,
             active,
             constants,
+            planar_ok,
             bits,
             view,
         })
@@ -396,14 +405,16 @@ impl Dcs {
         } = buffers;
         square_pairs(&Self::scan_input(p, f), wedges, rect, pairs, scan);
         counts.scanned += pairs.scanned;
+        counts.ties += pairs.ties;
         counts.tile_wedges += pairs.tile_wedges;
         counts.square_wedges += pairs.square_wedges;
         counts.pairs += pairs.len() as u64;
         let w = view.width() as usize;
-        for i in rect.pixels(view.width()) {
+        for (j, x, y) in pairs.pixels() {
+            let i = y as usize * w + x as usize;
             let Some(s) = view.get(i) else { continue };
-            let (x, y) = ((i % w) as u32, (i / w) as u32);
-            let class = self.pixel(p, f, i, &s, pairs.of(x, y), scratch, counts);
+            let (entries, tests) = pairs.of(j);
+            let class = self.pixel(p, f, i, &s, entries, tests, scratch, counts);
             visit(i, &s, class, scratch);
         }
     }
@@ -412,14 +423,14 @@ impl Dcs {
     fn scan_input<'a>(p: &'a Prepared, f: &'a Frame) -> ScanInput<'a> {
         ScanInput {
             edges: &p.edges,
-            wedges: &p.wedges,
-            boxes: &p.boxes,
+            wedges: &p.scan,
             c: p.shape.center.as_dvec3(),
             width: f.view.width(),
             origins: &f.origins,
             centred: &f.centred,
             active: &f.active,
             slack: (FOLD_SLACK * p.extent) as f32,
+            planar: (!f.planar_ok.is_empty()).then_some((&p.centred_edges[..], &f.planar_ok[..])),
         }
     }
 
@@ -449,7 +460,7 @@ impl Dcs {
             })
             .collect();
         let masks: Vec<u64> = p
-            .boxes
+            .scan
             .par_iter()
             .flat_map_iter(|w| groups.iter().map(move |g| g.test(w, slack)))
             .collect();
@@ -459,7 +470,7 @@ impl Dcs {
             .enumerate()
             .map(|(bi, (_, squares))| {
                 let (g, bit) = (bi / BOXES, bi % BOXES);
-                let kept: Vec<u32> = (0..p.boxes.len() as u32)
+                let kept: Vec<u32> = (0..p.scan.len() as u32)
                     .filter(|&wi| masks[wi as usize * ng + g] >> bit & 1 == 1)
                     .collect();
                 // The block's wedges against its squares' boxes.
@@ -471,7 +482,7 @@ impl Dcs {
                 );
                 let mut lists: Vec<Vec<u32>> = vec![Vec::new(); squares.len()];
                 for &wi in &kept {
-                    for s in bits_of(sq.test(&p.boxes[wi as usize], slack)) {
+                    for s in bits_of(sq.test(&p.scan[wi as usize], slack)) {
                         lists[s].push(wi);
                     }
                 }
@@ -524,6 +535,7 @@ impl Dcs {
         i: usize,
         s: &ViewSample,
         entries: &[Pair],
+        tests: &[PlanarTest],
         scratch: &mut Scratch,
         counts: &mut Counts,
     ) -> PixelClass {
@@ -573,26 +585,19 @@ impl Dcs {
         let all_above = horizon == Horizon::Above;
         // The light-plane form of the test (planar lights, exact covered samples, a receiver
         // clear of the light's plane).
-        let planar = match (&p.planar, self.covered) {
-            (Some(pl), CoveredSamples::Exact)
-                if f.centred[i].dot(pl.normal).abs() > NEAR_PLANE * f.centred[i].length() =>
-            {
-                Some(pl)
-            }
-            _ => None,
-        };
+        let planar = f.planar_ok.get(i).copied().unwrap_or(false);
         let mut ready = horizon == Horizon::Mixed;
         if ready {
-            self.sample_setup(p, s, origin, indexed, all_above, planar.is_some(), scratch);
+            self.sample_setup(p, s, origin, indexed, all_above, planar, scratch);
         }
-        if let (Some(pl), false) = (planar, entries.is_empty()) {
+        if planar && !entries.is_empty() {
             if !ready {
                 self.sample_setup(p, s, origin, indexed, all_above, true, scratch);
                 ready = true;
             }
-            Self::planar_pairs(p, pl, f.centred[i], pc, entries, indexed, scratch, counts);
+            Self::planar_pairs(entries, tests, indexed, scratch, counts);
         }
-        for pair in entries.iter().filter(|_| planar.is_none()) {
+        for pair in entries.iter().filter(|_| !planar) {
             let Some(test) = p.centred_edges[pair.edge as usize].test(pc) else {
                 counts.ties += 1;
                 continue;
@@ -887,48 +892,56 @@ impl Dcs {
         scratch.batch_edge.clear();
     }
 
-    /// The covered samples of every pair of a pixel by the light-plane test (planar lights,
-    /// samples set up), four pairs at a time: their tests, their sectors' bucket ranges (with
-    /// `indexed`; otherwise every sample is a candidate), then the exact test on the
+    /// The covered samples of every pair of a pixel by its light-plane test (`tests`, set up
+    /// by the wedge scan; samples set up), four pairs at a time: their sectors' bucket ranges
+    /// (with `indexed`; otherwise every sample is a candidate), then the exact test on the
     /// candidates, appended to the pixel's updates when any.
-    #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
     fn planar_pairs(
-        p: &Prepared,
-        pl: &PlanarLight,
-        pf: Vec3,
-        pc: DVec3,
         entries: &[Pair],
+        tests: &[PlanarTest],
         indexed: bool,
         scratch: &mut Scratch,
         counts: &mut Counts,
     ) {
         let words = scratch.above.len();
-        let pf_norm = pf.length();
         scratch.mask.resize(words, 0);
-        for chunk in entries.chunks(4) {
-            let mut tests = [PlanarTest::NONE; 4];
-            let mut valid = 0u32;
-            for (j, pair) in chunk.iter().enumerate() {
-                let e = pair.edge as usize;
-                match pl.edges[e].test(pf, pf_norm, &p.centred_edges[e], pc) {
-                    Some(t) => {
-                        tests[j] = t;
-                        valid |= 1 << j;
+        scratch.batch_candidates.resize(words, 0);
+        counts.edge_tests += tests.len() as u64;
+        if let (true, [above]) = (indexed, &scratch.above[..]) {
+            // One word of samples: candidates and covered samples as plain words.
+            let samples = &scratch.planar_samples;
+            let (xs, ys) = (samples.first_word_x(), samples.first_word_y());
+            for (pairs, quad) in entries.chunks(4).zip(tests.chunks(4)) {
+                let mut four = [PlanarTest::NONE; 4];
+                four[..quad.len()].copy_from_slice(quad);
+                let r = QuadRanges::of_tests(&four);
+                for (j, (pair, test)) in pairs.iter().zip(quad).enumerate() {
+                    let cand = scratch.angular.quad_word(&r, j) & above;
+                    if cand == 0 {
+                        counts.sector_empty += 1;
+                        continue;
                     }
-                    None => counts.ties += 1,
+                    let hit = test.covered_of(xs, ys, cand);
+                    if hit != 0 {
+                        counts.covered_updates += 1;
+                        scratch.masks.push(hit);
+                        scratch.weights.push(i64::from(pair.k));
+                    }
                 }
             }
-            counts.edge_tests += u64::from(valid.count_ones());
-            let ranges = indexed.then(|| QuadRanges::of_tests(&tests));
-            for (j, pair) in chunk.iter().enumerate() {
-                if valid >> j & 1 == 0 {
-                    continue;
-                }
-                let test = &tests[j];
+            return;
+        }
+        for (pairs, quad) in entries.chunks(4).zip(tests.chunks(4)) {
+            let ranges = indexed.then(|| {
+                let mut four = [PlanarTest::NONE; 4];
+                four[..quad.len()].copy_from_slice(quad);
+                QuadRanges::of_tests(&four)
+            });
+            for (j, (pair, test)) in pairs.iter().zip(quad).enumerate() {
                 let mut hit = 0u64;
                 if let Some(r) = &ranges {
                     let cand = &mut scratch.batch_candidates;
-                    cand.resize(words, 0);
                     if !scratch.angular.quad_candidates(r, j, &scratch.above, cand) {
                         counts.sector_empty += 1;
                         continue;
@@ -1014,6 +1027,7 @@ fn horizon_mask_into(positions: &[Vec3], s: &ViewSample, origin: Vec3, above: &m
 }
 
 /// Applies the updates with packed counters of `bits` bits.
+#[inline(never)]
 fn run_packed(
     packed: &mut Packed,
     bits: u32,
@@ -1118,23 +1132,24 @@ impl ShadowTechnique for Dcs {
             .map(|&i| CentredEdge::new(&edges[i as usize], cd))
             .collect();
         let wedges = stats.time("wedges", || wedges(&edges, &sil, &shape));
-        let planar = shape.plane.as_ref().map(|pl| {
-            let (u, v) = (pl.u.as_dvec3(), pl.v.as_dvec3());
-            PlanarLight {
-                u: pl.u,
-                v: pl.v,
-                normal: pl.u.cross(pl.v),
-                edges: sil
-                    .par_iter()
-                    .map(|&i| PlanarEdge::new(&edges[i as usize], cd, u, v))
-                    .collect(),
-            }
+        let planar = shape.plane.as_ref().map(|pl| PlanarLight {
+            u: pl.u,
+            v: pl.v,
+            normal: pl.u.cross(pl.v),
         });
-        let boxes = wedges.iter().map(WedgeBox::of).collect();
+        let scan = wedges
+            .par_iter()
+            .map(|w| {
+                let pe = shape.plane.as_ref().map(|pl| {
+                    let (u, v) = (pl.u.as_dvec3(), pl.v.as_dvec3());
+                    PlanarEdge::new(&edges[w.edge as usize], cd, u, v)
+                });
+                ScanWedge::new(w, pe)
+            })
+            .collect();
         self.prepared = Some(Prepared {
             planar,
-            wedges,
-            boxes,
+            scan,
             polygon,
             centred_edges,
             scene,
