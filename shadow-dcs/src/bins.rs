@@ -286,6 +286,8 @@ pub(crate) struct SquarePairs {
     tests: Vec<PlanarTest>,
     /// Pairs dropped on the tie of the light-plane test's orientation.
     pub ties: u64,
+    /// View samples whose weight took the exact form.
+    pub exact_weights: u64,
     /// View samples tested against a wedge's planes and weight.
     pub scanned: u64,
     /// (tile, wedge) candidates evaluated on the tile's view samples.
@@ -376,6 +378,7 @@ pub(crate) fn square_pairs(
     out.tile_wedges = 0;
     out.square_wedges = wedges.len() as u64;
     out.ties = 0;
+    out.exact_weights = 0;
     let SquareScratch {
         tiles,
         lists,
@@ -428,6 +431,7 @@ pub(crate) fn square_pairs(
                 let k = match &fast {
                     Some(f) if f.certain >> j & 1 == 1 => f.k(j),
                     _ => {
+                        out.exact_weights += 1;
                         let e = &input.edges[wedge.edge as usize];
                         match e.sweep_weight(input.origins[i].as_dvec3(), input.c, false) {
                             Some(k) => k,

@@ -1,61 +1,43 @@
-//! Packed depth-complexity counters (DCS sections 4.3, 4.4 and 5.3): several unsigned counters
-//! share a 64-bit word (8 of 8 bits, 4 of 16 bits or 2 of 32 bits) and one word addition updates
-//! all of them (Fig. 3). The width is chosen per frame from the largest integration constant
-//! (section 5.3); an update that would carry out of a lane (overflow) or borrow into one
-//! (underflow) is detected with SWAR carry logic and reported, never wrapped, and the caller
-//! redoes the pixel with wider counters.
+//! Packed depth-complexity counters (DCS sections 4.3, 4.4 and 5.3), bit-sliced: the counters
+//! of 64 light samples share `bits` words, word `b` holding bit `b` of every counter, so that
+//! one update adds a mask of samples to all of them with a ripple of word operations (a carry
+//! or borrow mask per bit). This is the CPU form of the paper's packing (Fig. 3 adds four
+//! byte-wide counters with one 32-bit addition; here a `bits`-deep ripple updates 64 counters,
+//! usually stopping after a bit or two). The precision is chosen per frame from the largest
+//! integration constant (section 5.3); an update that would carry out of the top bit
+//! (overflow) or borrow past it (underflow) is detected and reported, never wrapped, and the
+//! caller redoes the pixel with more bits. Which samples have depth complexity zero (the
+//! visibility of eq. 1 and 5) is the complement of the union of the bit words.
 
-/// An update would leave a lane's range.
+/// An update would leave the counters' range.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct OutOfRange;
 
-/// Lane widths, narrowest first.
-pub(crate) const WIDTHS: [u32; 3] = [8, 16, 32];
+/// Counter precisions tried in turn (bits), the narrowest first; 64 bits hold any count.
+pub(crate) const WIDTHS: [u32; 4] = [8, 16, 32, 64];
 
-/// Counters for `n` samples in lanes of `bits` bits.
+/// Counters for `n` samples, `bits` bits each.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Packed {
     bits: u32,
     n: usize,
-    words: Vec<u64>,
+    /// Word `w * bits + b`: bit `b` of the counters of samples `64 w .. 64 w + 64`.
+    planes: Vec<u64>,
 }
 
-/// `0x0101...01` (one in the lowest bit of each lane) for a lane width.
-fn ones(bits: u32) -> u64 {
-    match bits {
-        8 => 0x0101_0101_0101_0101,
-        16 => 0x0001_0001_0001_0001,
-        _ => 0x0000_0001_0000_0001,
-    }
-}
-
-/// Bit `i` of a byte moved to bit `8 i` (the 8-bit lane increments of Fig. 3).
-const SPREAD8: [u64; 256] = {
-    let mut t = [0u64; 256];
-    let mut m = 0;
-    while m < 256 {
-        let mut i = 0;
-        while i < 8 {
-            t[m] |= ((m as u64 >> i) & 1) << (8 * i);
-            i += 1;
-        }
-        m += 1;
-    }
-    t
-};
-
-/// Spreads the low `64 / bits` bits of `m` to the lowest bit of each lane.
+/// The first `n - 64 w` bits of word `w` (the samples that exist).
 #[inline]
-fn spread(m: u64, bits: u32) -> u64 {
-    match bits {
-        8 => SPREAD8[(m & 0xff) as usize],
-        16 => (m & 1) | (((m >> 1) & 1) << 16) | (((m >> 2) & 1) << 32) | (((m >> 3) & 1) << 48),
-        _ => (m & 1) | (((m >> 1) & 1) << 32),
+fn valid(n: usize, w: usize) -> u64 {
+    let left = n - 64 * w;
+    if left >= 64 {
+        u64::MAX
+    } else {
+        (1 << left) - 1
     }
 }
 
 impl Packed {
-    /// Largest value a lane of `bits` bits holds.
+    /// Largest value a counter of `bits` bits holds.
     pub fn lane_max(bits: u32) -> u64 {
         if bits >= 64 {
             u64::MAX
@@ -71,93 +53,109 @@ impl Packed {
         }
         self.bits = bits;
         self.n = n;
-        let lanes = (64 / bits) as usize;
-        self.words.clear();
-        self.words.resize(n.div_ceil(lanes), init * ones(bits));
+        self.planes.clear();
+        for w in 0..n.div_ceil(64) {
+            let v = valid(n, w);
+            self.planes
+                .extend((0..bits).map(|b| if init >> b & 1 == 1 { v } else { 0 }));
+        }
         Ok(())
-    }
-
-    /// Lane mask of word `w` taken from the sample bit mask.
-    #[inline]
-    fn lane_bits(&self, mask: &[u64], w: usize) -> u64 {
-        let lanes = 64 / self.bits as usize;
-        let first = w * lanes;
-        (mask[first / 64] >> (first % 64)) & ((1u64 << lanes) - 1)
     }
 
     /// Adds `k` to every counter whose bit is set in `mask`.
     pub fn add(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
-        self.update(mask, k, |x, y, high, low| {
-            let s = ((x & low) + (y & low)) ^ ((x ^ y) & high);
-            // Carry out of each lane's top bit.
-            (s, ((x & y) | ((x | y) & !s)) & high)
-        })
+        self.update(mask, k, |x, carry| (x ^ carry, x & carry))
     }
 
     /// Subtracts `k` from every counter whose bit is set in `mask`.
     pub fn sub(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
-        self.update(mask, k, |x, y, high, low| {
-            let d = ((x | high) - (y & low)) ^ ((x ^ !y) & high);
-            // Borrow out of each lane's top bit.
-            (d, ((!x & y) | (!(x ^ y) & d)) & high)
-        })
+        self.update(mask, k, |x, borrow| (x ^ borrow, !x & borrow))
     }
 
-    /// Applies a lane-wise operation `op(x, y, high, low) -> (result, out-of-range lanes)` with
-    /// `y` holding `k` in the lanes `mask` selects; stops at the first word that leaves range.
+    /// Adds or subtracts (`step(bit word, carry) -> (new word, carry out)`) `k` times the
+    /// samples of `mask`: for each set bit `b` of `k`, a ripple from bit word `b` up. Stops at
+    /// the first carry out of the top bit; the counters are then partly updated, and the caller
+    /// starts the pixel again.
     #[inline]
     fn update(
         &mut self,
         mask: &[u64],
         k: u64,
-        op: impl Fn(u64, u64, u64, u64) -> (u64, u64),
+        step: impl Fn(u64, u64) -> (u64, u64),
     ) -> Result<(), OutOfRange> {
         if k > Self::lane_max(self.bits) {
             return Err(OutOfRange);
         }
-        let high = ones(self.bits) << (self.bits - 1);
-        let low = !high;
-        for w in 0..self.words.len() {
-            let m = self.lane_bits(mask, w);
+        let bits = self.bits as usize;
+        for (w, &m) in mask.iter().enumerate().take(self.n.div_ceil(64)) {
+            let m = m & valid(self.n, w);
             if m == 0 {
                 continue;
             }
-            let (r, out) = op(self.words[w], spread(m, self.bits) * k, high, low);
-            if out != 0 {
-                return Err(OutOfRange);
+            let planes = &mut self.planes[w * bits..(w + 1) * bits];
+            let mut todo = k;
+            while todo != 0 {
+                let b = todo.trailing_zeros() as usize;
+                todo &= todo - 1;
+                let mut carry = m;
+                for x in &mut planes[b..] {
+                    (*x, carry) = step(*x, carry);
+                    if carry == 0 {
+                        break;
+                    }
+                }
+                if carry != 0 {
+                    return Err(OutOfRange);
+                }
             }
-            self.words[w] = r;
         }
         Ok(())
     }
 
-    /// Appends every counter, in order, to `out` (lane by lane, without a division each).
+    /// Appends every counter, in order, to `out`.
     pub fn unpack_into(&self, out: &mut Vec<u64>) {
-        let lanes = (64 / self.bits) as usize;
-        let max = Self::lane_max(self.bits);
-        let mut left = self.n;
-        for &w in &self.words {
-            let take = left.min(lanes);
-            out.extend((0..take).map(|j| (w >> (j as u32 * self.bits)) & max));
-            left -= take;
+        let bits = self.bits as usize;
+        for i in 0..self.n {
+            let planes = &self.planes[(i / 64) * bits..(i / 64 + 1) * bits];
+            let v = planes
+                .iter()
+                .enumerate()
+                .fold(0u64, |v, (b, x)| v | ((x >> (i % 64)) & 1) << b);
+            out.push(v);
+        }
+    }
+
+    /// Sets bit `i` of `out` (whole words) for every counter `i` that is zero, clears the rest.
+    pub fn zero_mask_into(&self, out: &mut [u64]) {
+        let bits = self.bits as usize;
+        for (w, o) in out.iter_mut().enumerate() {
+            *o = if w < self.n.div_ceil(64) {
+                let any = self.planes[w * bits..(w + 1) * bits]
+                    .iter()
+                    .fold(0, |a, x| a | x);
+                !any & valid(self.n, w)
+            } else {
+                0
+            };
         }
     }
 
     /// Counter `i`.
     #[cfg(test)]
     pub fn get(&self, i: usize) -> u64 {
-        let lanes = (64 / self.bits) as usize;
-        (self.words[i / lanes] >> ((i % lanes) as u32 * self.bits)) & Self::lane_max(self.bits)
+        let mut all = Vec::new();
+        self.unpack_into(&mut all);
+        all[i]
     }
 }
 
-/// The narrowest lane width whose range holds twice `max_constant` (section 5.3, with headroom
-/// for penumbra samples deeper than the centre).
+/// The narrowest precision of [`WIDTHS`] whose range holds twice `max_constant` (section
+/// 5.3, with headroom for penumbra samples deeper than the centre).
 pub(crate) fn width_for(max_constant: u64) -> u32 {
     WIDTHS
         .into_iter()
         .find(|&b| max_constant.saturating_mul(2) < Packed::lane_max(b))
-        .unwrap_or(32)
+        .unwrap_or(64)
 }
 
 #[cfg(test)]
@@ -165,46 +163,77 @@ mod tests {
     use super::*;
 
     #[test]
-    fn spread_puts_each_bit_in_its_lane() {
-        for m in 0..256u64 {
-            let s = spread(m, 8);
-            for i in 0..8 {
-                assert_eq!((s >> (8 * i)) & 0xff, (m >> i) & 1, "{m} {i}");
-            }
-        }
-        for m in 0..16u64 {
-            let s = spread(m, 16);
-            for i in 0..4 {
-                assert_eq!((s >> (16 * i)) & 0xffff, (m >> i) & 1);
+    fn packed_updates_match_plain_counters() {
+        for bits in WIDTHS {
+            for n in [5usize, 64, 100] {
+                let mut p = Packed::default();
+                p.reset(bits, n, 3).unwrap();
+                let mut plain = vec![3u64; n];
+                let mut state = 12345u64;
+                for step in 0..50 {
+                    state = shadow_core::sampling::mix64(state);
+                    let mask = [state, shadow_core::sampling::mix64(state ^ 7)];
+                    let k = 1 + step % 3;
+                    p.add(&mask, k).unwrap();
+                    for i in 0..n {
+                        if mask[i / 64] >> (i % 64) & 1 == 1 {
+                            plain[i] += k;
+                        }
+                    }
+                }
+                for i in 0..n {
+                    assert_eq!(p.get(i), plain[i], "bits {bits} counter {i}");
+                }
+                let mut all = Vec::new();
+                p.unpack_into(&mut all);
+                assert_eq!(all, plain, "bits {bits}: unpacked");
             }
         }
     }
 
     #[test]
-    fn packed_updates_match_plain_counters() {
+    fn zero_masks_match_the_counters() {
         for bits in WIDTHS {
-            let n = 100;
-            let mut p = Packed::default();
-            p.reset(bits, n, 3).unwrap();
-            let mut plain = vec![3u64; n];
-            let mut state = 12345u64;
-            for step in 0..50 {
-                state = shadow_core::sampling::mix64(state);
-                let mask = [state, shadow_core::sampling::mix64(state ^ 7)];
-                let k = 1 + step % 3;
-                p.add(&mask, k).unwrap();
-                for i in 0..n {
-                    if mask[i / 64] >> (i % 64) & 1 == 1 {
-                        plain[i] += k;
+            for n in [5usize, 64, 100] {
+                let mut p = Packed::default();
+                p.reset(bits, n, 1).unwrap();
+                let mut plain = vec![1i64; n];
+                let mut state = 99u64;
+                let mut zeros = 0;
+                for step in 0..20 {
+                    state = shadow_core::sampling::mix64(state);
+                    let mut m = [state, shadow_core::sampling::mix64(state ^ 3)];
+                    let up = step % 2 == 1;
+                    if !up {
+                        // Only counters above zero go down (a failed update may have changed
+                        // some words: the technique redoes such a pixel from the start).
+                        for i in 0..n {
+                            if plain[i] == 0 {
+                                m[i / 64] &= !(1 << (i % 64));
+                            }
+                        }
+                    }
+                    let done = if up { p.add(&m, 1) } else { p.sub(&m, 1) };
+                    assert!(done.is_ok());
+                    for i in 0..n {
+                        if m[i / 64] >> (i % 64) & 1 == 1 {
+                            plain[i] += if up { 1 } else { -1 };
+                        }
+                    }
+                    let mut zero = [0u64; 2];
+                    p.zero_mask_into(&mut zero);
+                    for i in 0..128 {
+                        let got = zero[i / 64] >> (i % 64) & 1 == 1;
+                        assert_eq!(
+                            got,
+                            i < n && plain[i] == 0,
+                            "bits {bits} n {n} step {step} counter {i}"
+                        );
+                        zeros += usize::from(got);
                     }
                 }
+                assert!(zeros > 0, "bits {bits} n {n}: no zero reached");
             }
-            for i in 0..n {
-                assert_eq!(p.get(i), plain[i], "bits {bits} counter {i}");
-            }
-            let mut all = Vec::new();
-            p.unpack_into(&mut all);
-            assert_eq!(all, plain, "bits {bits}: unpacked");
         }
     }
 
@@ -216,17 +245,23 @@ mod tests {
         p.add(&mask, 5).unwrap();
         assert_eq!(p.get(1), 255);
         assert_eq!(p.add(&mask, 1), Err(OutOfRange));
-        // The failed update left every counter as it was.
-        assert_eq!(p.get(1), 255);
-        assert_eq!(p.get(0), 250);
         p.reset(16, 8, 1).unwrap();
         p.sub(&[0b100], 1).unwrap();
         assert_eq!(p.get(2), 0);
         assert_eq!(p.sub(&[0b100], 1), Err(OutOfRange));
         assert_eq!(p.get(3), 1);
         assert!(p.reset(8, 4, 256).is_err());
+        // A weight wider than the counters is out of range too.
+        p.reset(8, 4, 0).unwrap();
+        assert_eq!(p.add(&[1], 256), Err(OutOfRange));
+        // Sixty-four bits hold the largest weights.
+        p.reset(64, 4, u64::MAX - 1).unwrap();
+        p.add(&[1], 1).unwrap();
+        assert_eq!(p.get(0), u64::MAX);
+        assert_eq!(p.add(&[1], 1), Err(OutOfRange));
         assert_eq!(width_for(10), 8);
         assert_eq!(width_for(200), 16);
         assert_eq!(width_for(40_000), 32);
+        assert_eq!(width_for(u64::MAX / 2), 64);
     }
 }

@@ -195,6 +195,12 @@ struct Scratch {
     weights: Vec<i64>,
     packed: Packed,
     plain: Vec<i64>,
+    /// Whether the caller reads each sample's visibility and depth complexity (`vis`,
+    /// `depth`); without, only `visible` is set.
+    want_values: bool,
+    /// The samples visible from the pixel (depth complexity 0, above the horizon), one bit
+    /// each.
+    visible: Vec<u64>,
     depth: Vec<u64>,
     vis: Vec<f32>,
 }
@@ -221,6 +227,7 @@ struct Counts {
     negative: u64,
     ties: u64,
     scanned: u64,
+    exact_weights: u64,
     tile_wedges: u64,
     square_wedges: u64,
     pairs: u64,
@@ -241,6 +248,7 @@ impl Counts {
         self.negative += o.negative;
         self.ties += o.ties;
         self.scanned += o.scanned;
+        self.exact_weights += o.exact_weights;
         self.tile_wedges += o.tile_wedges;
         self.square_wedges += o.square_wedges;
         self.pairs += o.pairs;
@@ -406,6 +414,7 @@ impl Dcs {
         square_pairs(&Self::scan_input(p, f), wedges, rect, pairs, scan);
         counts.scanned += pairs.scanned;
         counts.ties += pairs.ties;
+        counts.exact_weights += pairs.exact_weights;
         counts.tile_wedges += pairs.tile_wedges;
         counts.square_wedges += pairs.square_wedges;
         counts.pairs += pairs.len() as u64;
@@ -546,10 +555,15 @@ impl Dcs {
         scratch.vis.clear();
         scratch.depth.clear();
         scratch.samples.clear();
+        scratch.visible.clear();
+        scratch.visible.resize(words, 0);
+        let values = scratch.want_values;
         if horizon == Horizon::Below {
             counts.facing_away += 1;
-            scratch.vis.resize(n, 0.0);
-            scratch.depth.resize(n, u64::MAX);
+            if values {
+                scratch.vis.resize(n, 0.0);
+                scratch.depth.resize(n, u64::MAX);
+            }
             return PixelClass::Skipped;
         }
         let mut d0 = f.constants[i];
@@ -631,8 +645,13 @@ impl Dcs {
             // No wedge: every sample has the integration constant.
             counts.constant_only += 1;
             let v = 1.0 - (d0 as f32 / units).min(1.0);
-            scratch.vis.resize(n, v);
-            scratch.depth.resize(n, d0);
+            if d0 == 0 {
+                fill_first(&mut scratch.visible, n);
+            }
+            if values {
+                scratch.vis.resize(n, v);
+                scratch.depth.resize(n, d0);
+            }
             if textured {
                 self.sampler.unit_samples(s.pixel, &mut scratch.units);
                 let light = p.light.as_ref();
@@ -661,6 +680,30 @@ impl Dcs {
             )
             .is_ok()
             {
+                if !values {
+                    // Only which samples are visible: the zero counters above the horizon.
+                    scratch.packed.zero_mask_into(&mut scratch.visible);
+                    let mut any = 0u64;
+                    let mut all = true;
+                    for (k, (v, a)) in scratch.visible.iter_mut().zip(&scratch.above).enumerate() {
+                        *v &= *a;
+                        any |= *v;
+                        let left = n - k * 64;
+                        all &= *v
+                            == if left >= 64 {
+                                u64::MAX
+                            } else {
+                                (1 << left) - 1
+                            };
+                    }
+                    return if all {
+                        PixelClass::Lit
+                    } else if any == 0 {
+                        PixelClass::Umbra
+                    } else {
+                        PixelClass::Penumbra
+                    };
+                }
                 scratch.packed.unpack_into(&mut scratch.depth);
                 done = true;
                 break;
@@ -703,6 +746,9 @@ impl Dcs {
             };
             lit &= v == 1.0;
             dark &= v == 0.0;
+            if v == 1.0 {
+                scratch.visible[k / 64] |= 1 << (k % 64);
+            }
             scratch.vis.push(v);
         }
         if lit {
@@ -981,6 +1027,8 @@ impl Dcs {
             let mut counts = Counts::default();
             let mut units = Vec::new();
             let mut samples = Vec::new();
+            // Eq. 6 weighs every sample by its visibility.
+            buffers.scratch.want_values = true;
             self.run_strip(
                 p,
                 &f,
@@ -1023,6 +1071,18 @@ fn horizon_mask_into(positions: &[Vec3], s: &ViewSample, origin: Vec3, above: &m
         if (*y - s.position).dot(nrm) > 0.0 && (*y - origin).dot(nrm) > 0.0 {
             above[k / 64] |= 1 << (k % 64);
         }
+    }
+}
+
+/// Sets the first `n` bits of `words` (the rest stay as they are).
+fn fill_first(words: &mut [u64], n: usize) {
+    for (k, w) in words.iter_mut().enumerate() {
+        let left = n.saturating_sub(k * 64);
+        *w = if left >= 64 {
+            u64::MAX
+        } else {
+            (1 << left) - 1
+        };
     }
 }
 
@@ -1209,6 +1269,8 @@ impl ShadowTechnique for Dcs {
                     counts: Counts::default(),
                 };
                 let mut counts = Counts::default();
+                buffers.scratch.want_values =
+                    textured || output == PerSampleOutput::Counters || p.units != 1;
                 self.run_strip(
                     p,
                     &f,
@@ -1242,6 +1304,16 @@ impl ShadowTechnique for Dcs {
                                         (1 << left) - 1
                                     };
                                 }
+                            }
+                            return;
+                        }
+                        if !scratch.want_values {
+                            // Whole units, no texture, bits at most: the visible samples say all.
+                            let seen: u32 = scratch.visible.iter().map(|w| w.count_ones()).sum();
+                            r.v[x] = (f64::from(seen) / n as f64) as f32;
+                            if output == PerSampleOutput::Bits {
+                                r.bits[x * words..(x + 1) * words]
+                                    .copy_from_slice(&scratch.visible);
                             }
                             return;
                         }
@@ -1339,6 +1411,7 @@ impl ShadowTechnique for Dcs {
         stats.add("negative-depth-complexity", counts.negative);
         stats.add("edge-ties", counts.ties);
         stats.add("wedge-pixels-scanned", counts.scanned);
+        stats.add("wedge-exact-weights", counts.exact_weights);
         stats.add("bin-block-wedges", block_wedges);
         stats.add("bin-square-wedges", counts.square_wedges);
         stats.add("bin-tile-wedges", counts.tile_wedges);
