@@ -26,7 +26,9 @@ use glam::{BVec4A, DVec3, Vec3, Vec4};
 use crate::centred::FastWeight;
 use crate::centred::{CentredEdge, CentredPlane};
 use crate::edges::SceneEdge;
-use crate::lanes::{LANES, LaneMask, TILE_H, TILE_W, TileLanes, TileQuads, lanes_of, rect_lanes};
+use crate::lanes::{
+    LANES, LaneMask, QUADS, TILE_H, TILE_W, TileLanes, TileQuads, lanes_of, rect_lanes,
+};
 use crate::planar::{PlanarEdge, PlanarTest};
 use crate::wedges::{Pair, Wedge};
 
@@ -100,7 +102,7 @@ impl ScanWedge {
                 break;
             }
             let [nx, ny, nz, d] = [p[0], p[1], p[2], p[3]].map(Vec4::splat);
-            for q in 0..4 {
+            for q in 0..QUADS {
                 let v = nx * t.x[q] + ny * t.y[q] + nz * t.z[q] + d;
                 alive &= !((v.cmplt(Vec4::ZERO).bitmask() as LaneMask) << (4 * q));
             }

@@ -18,7 +18,7 @@ use glam::{DVec3, Vec3, Vec4};
 
 use crate::coverage::EdgeTest;
 use crate::edges::SceneEdge;
-use crate::lanes::{LANES, LaneMask, TileQuads};
+use crate::lanes::{LANES, LaneMask, QUADS, TileQuads};
 
 /// Relative error bound of an `f32` plane evaluation, against `|n|_1 |x'|_1 + |d|`. The value
 /// carries the rounding of `n` and `d` to `f32` (one unit in the last place, `6e-8`, each), of
@@ -63,7 +63,7 @@ impl CentredPlane {
 
     /// The values at the four lane quads of a tile.
     #[inline(always)]
-    fn eval_quads(&self, t: &TileQuads) -> [Vec4; 4] {
+    fn eval_quads(&self, t: &TileQuads) -> [Vec4; QUADS] {
         let (nx, ny, nz, d) = (
             Vec4::splat(self.n.x),
             Vec4::splat(self.n.y),
@@ -76,10 +76,10 @@ impl CentredPlane {
     /// The lanes of `lanes` whose magnitude of `v` exceeds this plane's error bound there (a
     /// certain sign; NaN fails).
     #[inline(always)]
-    fn certain_quads(&self, t: &TileQuads, v: &[Vec4; 4]) -> LaneMask {
+    fn certain_quads(&self, t: &TileQuads, v: &[Vec4; QUADS]) -> LaneMask {
         let (bn, bd) = (Vec4::splat(self.bound_n), Vec4::splat(self.bound_d));
         let mut m = 0;
-        for q in 0..4 {
+        for q in 0..QUADS {
             m |= (v[q].abs().cmpgt(bn * t.l1[q] + bd).bitmask() as LaneMask) << (4 * q);
         }
         m
@@ -156,7 +156,7 @@ const LANE_WEIGHT_MAX: i64 = 1 << 22;
 
 /// The mask of lanes where a lane quad comparison holds.
 #[inline(always)]
-fn mask_of(v: &[glam::BVec4A; 4]) -> LaneMask {
+fn mask_of(v: &[glam::BVec4A; QUADS]) -> LaneMask {
     let mut m = 0;
     for (q, b) in v.iter().enumerate() {
         m |= (b.bitmask() as LaneMask) << (4 * q);
@@ -176,7 +176,7 @@ impl FastWeight {
         let v = self.through_center.eval_quads(t);
         let mut certain = self.through_center.certain_quads(t, &v);
         let from_negative = v.map(|x| x.cmplt(zero));
-        let mut k = [zero; 4];
+        let mut k = [zero; QUADS];
         for f in self.faces.iter().flatten() {
             if f.weight > LANE_WEIGHT_MAX {
                 return None;
@@ -184,7 +184,7 @@ impl FastWeight {
             let w = Vec4::splat(f.weight as f32);
             let v = f.plane.eval_quads(t);
             certain &= f.plane.certain_quads(t, &v);
-            for q in 0..4 {
+            for q in 0..QUADS {
                 let positive = v[q].cmpgt(zero);
                 let front = if f.front_positive {
                     positive
@@ -203,7 +203,7 @@ impl FastWeight {
         }
         let nonzero = mask_of(&k.map(|x| x.cmpne(zero)));
         let mut out = [0.0f32; LANES];
-        for q in 0..4 {
+        for q in 0..QUADS {
             out[4 * q..4 * q + 4].copy_from_slice(&k[q].to_array());
         }
         Some(LaneWeights {

@@ -30,6 +30,11 @@ use crate::edges::{SceneEdge, ray_hits_triangle};
 /// than 178 degrees from the light centre (an occluder touching the centre).
 const FAR_FACTOR: f64 = 64.0;
 
+/// Relative error bound of a quad's plane value in single precision around the light centre,
+/// against `|n| . |p'|`: the rounding of the normal, of the centred point and of three products
+/// and two sums is below `1e-6` of it.
+const SIDE_BOUND: f32 = 1e-5;
+
 /// Rows per band of the parallel quad rasterization.
 const SV_BAND: u32 = 8;
 
@@ -75,6 +80,7 @@ pub(crate) fn integration_constants(
     eye_constant: i64,
     view: &RasterView,
     origins: &[Vec3],
+    centred: &[Vec3],
     valid: &[bool],
 ) -> (Vec<i64>, u64) {
     let cd = c.as_dvec3();
@@ -158,6 +164,21 @@ pub(crate) fn integration_constants(
             }
         }
     }
+    // The quads' planes in single precision around the light centre, with the bound of the
+    // rounding of a plane value there (`SIDE_BOUND |n| . |p'|`); a value within it is taken
+    // again in double precision.
+    let sides: Vec<(Vec3, Vec3)> = quads
+        .iter()
+        .map(|(_, _, normal, _)| {
+            let scale = normal.abs().max_element();
+            let n = if scale > 0.0 {
+                *normal / scale
+            } else {
+                *normal
+            };
+            (n.as_vec3(), n.abs().as_vec3() * SIDE_BOUND)
+        })
+        .collect();
     let mut sums = vec![0i64; n];
     sums.par_chunks_mut(SV_BAND as usize * w)
         .zip(&bins)
@@ -169,14 +190,24 @@ pub(crate) fn integration_constants(
             for &t in bin {
                 let (tri, qi) = &triangles[t as usize];
                 let (_, k, normal, eye_positive) = &quads[*qi as usize];
-                tri.for_each_in_rows(y0, y1, |x, y| {
-                    let i = y as usize * w + x as usize;
-                    if !valid[i] {
-                        return;
-                    }
-                    let side = normal.dot(origins[i].as_dvec3() - cd);
-                    if side != 0.0 && (side > 0.0) != *eye_positive {
-                        acc[i - first] += k;
+                let (nf, bound) = sides[*qi as usize];
+                tri.for_each_span_in_rows(y0, y1, |y, x0, x1| {
+                    let row = y as usize * w;
+                    for i in row + x0 as usize..=row + x1 as usize {
+                        if !valid[i] {
+                            continue;
+                        }
+                        // orient(c, a, b, p) = normal . (p - c): which side of the quad's plane.
+                        let pc = centred[i];
+                        let v = nf.dot(pc);
+                        let side = if v.abs() > bound.dot(pc.abs()) {
+                            f64::from(v)
+                        } else {
+                            normal.dot(origins[i].as_dvec3() - cd)
+                        };
+                        if side != 0.0 && (side > 0.0) != *eye_positive {
+                            acc[i - first] += k;
+                        }
                     }
                 });
             }
@@ -294,6 +325,10 @@ mod tests {
         let valid = view.valid_mask();
         let eye = view.eye().unwrap();
         let eye_c = eye_constant(&scene, units, eye, shape.center);
+        let centred: Vec<Vec3> = origins
+            .iter()
+            .map(|o| (o.as_dvec3() - shape.center.as_dvec3()).as_vec3())
+            .collect();
         let (got, quads) = integration_constants(
             &edges,
             &sil,
@@ -302,6 +337,7 @@ mod tests {
             eye_c,
             view.raster_view(),
             &origins,
+            &centred,
             &valid,
         );
         assert!(quads > 10);

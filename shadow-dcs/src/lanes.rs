@@ -12,10 +12,10 @@ pub(crate) const TILE_W: u32 = 4;
 /// The lanes of a tile as four packed quads per coordinate (lanes `4 q .. 4 q + 4` in quad `q`).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct TileQuads {
-    pub x: [Vec4; 4],
-    pub y: [Vec4; 4],
-    pub z: [Vec4; 4],
-    pub l1: [Vec4; 4],
+    pub x: [Vec4; QUADS],
+    pub y: [Vec4; QUADS],
+    pub z: [Vec4; QUADS],
+    pub l1: [Vec4; QUADS],
 }
 
 /// Rows of a tile.
@@ -23,6 +23,9 @@ pub(crate) const TILE_H: u32 = 4;
 
 /// View samples per tile; lane `j` is column `j % TILE_W`, row `j / TILE_W` of the tile.
 pub(crate) const LANES: usize = (TILE_W * TILE_H) as usize;
+
+/// Packed quads of four lanes per tile.
+pub(crate) const QUADS: usize = LANES / 4;
 
 /// One value per lane.
 pub(crate) type Lanes = [f32; LANES];
@@ -65,9 +68,9 @@ impl TileLanes {
     /// The lanes as packed quads.
     #[inline]
     pub fn quads(&self) -> TileQuads {
-        let q = |a: &Lanes| -> [Vec4; 4] {
+        let q = |a: &Lanes| -> [Vec4; QUADS] {
             let (c, _) = a.as_chunks::<4>();
-            [c[0], c[1], c[2], c[3]].map(Vec4::from)
+            std::array::from_fn(|i| Vec4::from(c[i]))
         };
         TileQuads {
             x: q(&self.x),

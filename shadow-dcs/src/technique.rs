@@ -348,6 +348,11 @@ impl Dcs {
             .unzip();
         let active: Vec<bool> = horizon.iter().map(|h| *h != Horizon::Below).collect();
         let c = p.shape.center;
+        let cd = c.as_dvec3();
+        let centred: Vec<Vec3> = origins
+            .par_iter()
+            .map(|o| (o.as_dvec3() - cd).as_vec3())
+            .collect();
         let (constants, quads) = stats.time("shadow-volumes", || {
             let eye_c = eye_constant(p.scene.as_ref(), p.units, eye, c);
             integration_constants(
@@ -358,6 +363,7 @@ impl Dcs {
                 eye_c,
                 view.raster_view(),
                 &origins,
+                &centred,
                 &active,
             )
         });
@@ -367,11 +373,6 @@ impl Dcs {
         stats.add("max-integration-constant", max_constant);
         stats.add("counter-bits", bits as u64);
         stats.add("wedges", p.scan.len() as u64);
-        let cd = p.shape.center.as_dvec3();
-        let centred: Vec<Vec3> = origins
-            .par_iter()
-            .map(|o| (o.as_dvec3() - cd).as_vec3())
-            .collect();
         let planar_ok = match (&p.planar, self.covered) {
             (Some(pl), CoveredSamples::Exact) => centred
                 .par_iter()

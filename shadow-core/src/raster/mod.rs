@@ -197,6 +197,21 @@ impl CoveredPixels {
         Some((lo, hi))
     }
 
+    /// Calls `f(y, x0, x1)` for every row `y` in `y0..=y1` with covered pixels, each run
+    /// `x0..=x1` of covered pixels once (a part of the set-up covers one run per row, so a
+    /// triangle split by the near plane may give two). The same pixels as
+    /// [`CoveredPixels::for_each_in_rows`]: the run's ends are found by the exact coverage test,
+    /// every pixel between them is covered (coverage along a row is an interval).
+    pub fn for_each_span_in_rows(&self, y0: u32, y1: u32, mut f: impl FnMut(u32, u32, u32)) {
+        for st in &self.parts {
+            for y in st.ymin.max(y0)..=st.ymax.min(y1) {
+                if let Some((x0, x1)) = st.row_span(y) {
+                    f(y, x0, x1);
+                }
+            }
+        }
+    }
+
     /// Calls `f(x, y)` for every covered pixel in rows `y0..=y1`.
     pub fn for_each_in_rows(&self, y0: u32, y1: u32, mut f: impl FnMut(u32, u32)) {
         for st in &self.parts {
@@ -391,7 +406,21 @@ mod tests {
                 near: 0.1,
             },
         };
-        let triangles = [
+        // Random triangles too, some crossing the near plane, some thin.
+        let r = |k: u64, i: u64| {
+            crate::sampling::unit_float(crate::sampling::hash_words(&[k, i])) * 2.0 - 1.0
+        };
+        let random = (0..300u64).map(|k| {
+            std::array::from_fn(|v| {
+                let v = v as u64;
+                Vec3::new(
+                    r(k, 3 * v) * 2.0,
+                    r(k, 3 * v + 1) * 2.0,
+                    -2.0 + 1.8 * r(k, 3 * v + 2),
+                )
+            })
+        });
+        let fixed = [
             [
                 Vec3::new(-3.0, -2.0, -4.0),
                 Vec3::new(2.5, -1.0, -3.0),
@@ -410,11 +439,15 @@ mod tests {
                 Vec3::new(2.0, 1.01, -3.0),
             ],
         ];
-        for tri in triangles {
+        let mut covered = 0;
+        for (t, tri) in fixed.into_iter().chain(random).enumerate() {
             let mut whole = Vec::new();
             for_each_covered_pixel(&view, tri, |x, y| whole.push((x, y)));
             let cover = CoveredPixels::new(&view, tri);
-            let (lo, hi) = cover.rows().expect("the triangle covers rows");
+            let Some((lo, hi)) = cover.rows() else {
+                assert!(t >= 3 && whole.is_empty(), "triangle {t}");
+                continue;
+            };
             let mut banded = Vec::new();
             for y0 in (0..view.height).step_by(4) {
                 cover.for_each_in_rows(y0, y0 + 3, |x, y| {
@@ -422,13 +455,75 @@ mod tests {
                     banded.push((x, y));
                 });
             }
-            assert!(!whole.is_empty());
+            assert!(t >= 3 || !whole.is_empty());
+            covered += usize::from(!whole.is_empty());
             whole.sort_unstable();
             banded.sort_unstable();
             let n = banded.len();
             banded.dedup();
             assert_eq!(n, banded.len(), "a pixel reported twice");
             assert_eq!(whole, banded);
+            // The same pixels as runs.
+            let mut spans = Vec::new();
+            cover.for_each_span_in_rows(0, view.height, |y, x0, x1| {
+                spans.extend((x0..=x1).map(|x| (x, y)));
+            });
+            spans.sort_unstable();
+            assert_eq!(whole, spans, "runs of triangle {t}");
         }
+        assert!(covered > 100, "{covered}");
+    }
+
+    /// Rows whose pixel centres lie exactly on triangle edges (an orthographic view of 32 x 32
+    /// pixels over `[0, 32]^2`, vertices on the half-pixel grid): runs equal the per-pixel
+    /// visit, ties included.
+    #[test]
+    fn row_runs_settle_ties_like_the_pixel_test() {
+        let view = RasterView {
+            width: 32,
+            height: 32,
+            view_from_world: Affine3A::IDENTITY,
+            projection: Projection::Orthographic {
+                left: 0.0,
+                right: 32.0,
+                bottom: 0.0,
+                top: 32.0,
+                near: 0.1,
+            },
+        };
+        let mut ties = 0;
+        for k in 0..400u64 {
+            let r = |i: u64| crate::sampling::hash_words(&[k, i]) % 65;
+            // Vertices on multiples of a half pixel, some outside the image.
+            let tri: [Vec3; 3] = std::array::from_fn(|v| {
+                let v = v as u64;
+                Vec3::new(
+                    r(2 * v) as f32 * 0.5 - 0.25,
+                    r(2 * v + 1) as f32 * 0.5 - 0.25,
+                    -1.0,
+                )
+            });
+            let mut whole = Vec::new();
+            for_each_covered_pixel(&view, tri, |x, y| whole.push((x, y)));
+            let mut spans = Vec::new();
+            CoveredPixels::new(&view, tri).for_each_span_in_rows(0, 31, |y, x0, x1| {
+                spans.extend((x0..=x1).map(|x| (x, y)));
+            });
+            whole.sort_unstable();
+            spans.sort_unstable();
+            assert_eq!(whole, spans, "triangle {k}: {tri:?}");
+            // Count pixels whose centre lies on an edge line.
+            ties += whole
+                .iter()
+                .filter(|(x, y)| {
+                    let c = glam::Vec2::new(*x as f32 + 0.5, 31.5 - *y as f32);
+                    (0..3).any(|i| {
+                        let (a, b) = (tri[i].truncate(), tri[(i + 1) % 3].truncate());
+                        (b - a).perp_dot(c - a) == 0.0
+                    })
+                })
+                .count();
+        }
+        assert!(ties > 50, "{ties} pixels on an edge");
     }
 }

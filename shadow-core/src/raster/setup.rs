@@ -17,6 +17,10 @@ pub(super) struct ScreenTriangle {
     area: f64,
     /// Top-left flags per edge `i -> i+1`.
     top_left: [bool; 3],
+    /// Per edge `i -> i+1`: where its line crosses a row's centre line `yc`,
+    /// `x = cross[i].0 + cross[i].1 yc`, and whether the inside lies right of it (`1.0`), left
+    /// of it (`-1.0`) or the edge is horizontal (`0.0`, inside when `horizontal_inside`).
+    cross: [(f64, f64, f64); 3],
     pub xmin: u32,
     pub xmax: u32,
     pub ymin: u32,
@@ -55,19 +59,18 @@ impl ScreenTriangle {
     pub fn row_candidates(&self, y: u32) -> Option<(u32, u32)> {
         let yc = y as f64 + 0.5;
         let (mut lo, mut hi) = (self.xmin as f64, self.xmax as f64 + 1.0);
-        for i in 0..3 {
-            let (a, b) = (self.p[i], self.p[(i + 1) % 3]);
-            // edge(a, b, (x, yc)) = (b.x - a.x)(yc - a.y) - (b.y - a.y)(x - a.x) >= 0.
-            let k = -(b.y - a.y);
-            let c0 = (b.x - a.x) * (yc - a.y) + (b.y - a.y) * a.x;
-            if k == 0.0 {
-                if c0 < 0.0 {
+        for (i, &(x0, slope, side)) in self.cross.iter().enumerate() {
+            // edge(a, b, (x, yc)) = (b.x - a.x)(yc - a.y) - (b.y - a.y)(x - a.x) >= 0: right of
+            // the crossing when b.y < a.y, left of it when b.y > a.y.
+            if side == 0.0 {
+                let (a, b) = (self.p[i], self.p[(i + 1) % 3]);
+                if (b.x - a.x) * (yc - a.y) < 0.0 {
                     return None;
                 }
                 continue;
             }
-            let x = -c0 / k;
-            if k > 0.0 {
+            let x = x0 + slope * yc;
+            if side > 0.0 {
                 lo = lo.max(x - 0.5);
             } else {
                 hi = hi.min(x - 0.5);
@@ -76,6 +79,72 @@ impl ScreenTriangle {
         let x0 = (lo.floor() - 1.0).max(self.xmin as f64);
         let x1 = (hi.ceil() + 1.0).min(self.xmax as f64);
         (x0 <= x1).then_some((x0 as u32, x1 as u32))
+    }
+
+    /// The covered pixels of row `y` as one run `x0..=x1` (`None` when none): exactly the pixels
+    /// [`ScreenTriangle::covers`] accepts. The run's ends come from where the edges cross the
+    /// row's centre line; an end within the rounding of that crossing (or any end, on a row
+    /// that a horizontal edge or a nearly horizontal one makes delicate) is settled by the
+    /// exact test.
+    pub fn row_span(&self, y: u32) -> Option<(u32, u32)> {
+        let yc = y as f64 + 0.5;
+        let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+        // Rounding of the crossings (a few units in the last place of their terms).
+        let mut err = 0.0f64;
+        for (i, &(x0, slope, side)) in self.cross.iter().enumerate() {
+            if side == 0.0 {
+                let (a, b) = (self.p[i], self.p[(i + 1) % 3]);
+                let c = (b.x - a.x) * (yc - a.y);
+                if c < 0.0 {
+                    return None;
+                }
+                if c == 0.0 {
+                    return self.row_span_exact(y);
+                }
+                continue;
+            }
+            let x = x0 + slope * yc - 0.5;
+            err = err.max((x0.abs() + (slope * yc).abs() + 1.0) * 1e-14);
+            if side > 0.0 {
+                lo = lo.max(x);
+            } else {
+                hi = hi.min(x);
+            }
+        }
+        let eps = err.max(1e-9);
+        if !(eps < 0.25) {
+            return self.row_span_exact(y);
+        }
+        let a = (lo - eps).ceil().max(self.xmin as f64);
+        let b = (hi + eps).floor().min(self.xmax as f64);
+        if !(a <= b) {
+            return None;
+        }
+        let (mut a, mut b) = (a as u32, b as u32);
+        // Pixels left of `a` or right of `b` are surely outside; between `lo + eps` and
+        // `hi - eps` surely inside.
+        if (a as f64) < lo + eps && !self.covers(a, y) {
+            a += 1;
+        }
+        if (b as f64) > hi - eps && b >= a && !self.covers(b, y) {
+            if b == 0 {
+                return None;
+            }
+            b -= 1;
+        }
+        (a <= b).then_some((a, b))
+    }
+
+    /// [`ScreenTriangle::row_span`] by the exact test from the widened candidates.
+    fn row_span_exact(&self, y: u32) -> Option<(u32, u32)> {
+        let (mut x0, mut x1) = self.row_candidates(y)?;
+        while x0 <= x1 && !self.covers(x0, y) {
+            x0 += 1;
+        }
+        while x1 > x0 && !self.covers(x1, y) {
+            x1 -= 1;
+        }
+        (x0 <= x1 && self.covers(x1, y)).then_some((x0, x1))
     }
 
     /// Linear depth at the centre of pixel `(x, y)` when covered.
@@ -160,12 +229,23 @@ pub(super) fn setup_triangle(v: [Vec3; 3], view: &RasterView) -> Vec<ScreenTrian
             let (dx, dy) = (c.x - a.x, c.y - a.y);
             (dy == 0.0 && dx > 0.0) || dy < 0.0
         });
+        let cross = std::array::from_fn(|i| {
+            let (a, c) = (p[i], p[(i + 1) % 3]);
+            let dy = c.y - a.y;
+            if dy == 0.0 {
+                (0.0, 0.0, 0.0)
+            } else {
+                let slope = (c.x - a.x) / dy;
+                (a.x - slope * a.y, slope, if dy < 0.0 { 1.0 } else { -1.0 })
+            }
+        });
         out.push(ScreenTriangle {
             p,
             z: [tri[0].1, tri[1].1, tri[2].1],
             perspective: persp,
             area,
             top_left,
+            cross,
             xmin: xmin as u32,
             xmax: xmax as u32,
             ymin: ymin as u32,
