@@ -558,4 +558,96 @@ mod tests {
         // The cone holds little more than the covered samples, far fewer than all.
         assert!(candidates < total / 16, "{candidates} of {total}");
     }
+
+    /// The light-plane form: the ranges of four tests at once hold every sample each test
+    /// covers, leave most other samples out, and one word of samples gives the same candidates
+    /// as the slice form.
+    #[test]
+    fn light_plane_candidates_hold_every_covered_sample() {
+        use crate::centred::CentredEdge;
+        use crate::edges::{EdgeFace, SceneEdge};
+        use crate::planar::{PlanarEdge, PlanarSamples};
+        let light = RectLight::facing(
+            Vec3::new(0.2, 3.0, -0.1),
+            Vec3::new(0.1, -1.0, 0.05),
+            1.2,
+            0.8,
+            Radiance::constant(Vec3::ONE).unwrap(),
+        )
+        .unwrap();
+        let shape = LightShape::new(&light, "test").unwrap();
+        let plane = shape.plane.clone().unwrap();
+        let sampler = LightSampler::new(SamplingStrategy::Stratified, 64, 3).unwrap();
+        let c = shape.center.as_dvec3();
+        let (u, v) = (plane.u.as_dvec3(), plane.v.as_dvec3());
+        let (mut units, mut samples, mut index) = (
+            Vec::new(),
+            PlanarSamples::default(),
+            AngularIndex::default(),
+        );
+        let (mut covered, mut candidates, mut total) = (0u32, 0u32, 0u32);
+        for k in 0..1500u64 {
+            let r = |i: u64| unit_float(hash_words(&[k, i])) as f64 * 2.0 - 1.0;
+            let p = DVec3::new(r(0) * 2.0, 0.0, r(1) * 2.0);
+            sampler.unit_samples(glam::UVec2::new(k as u32, 7), &mut units);
+            let pos: Vec<Vec3> = units.iter().map(|u| light.sample(*u).position).collect();
+            samples.set(&pos, shape.center, plane.u, plane.v);
+            index.build_planar(&samples, pos.len());
+            let tests: Vec<_> = (0..4u64)
+                .filter_map(|j| {
+                    let mid = DVec3::new(r(2 + 8 * j), 1.5 + r(3 + 8 * j), r(4 + 8 * j));
+                    let dir = DVec3::new(r(5 + 8 * j), r(6 + 8 * j) * 0.3, r(7 + 8 * j)) * 0.3;
+                    let (a, b) = (mid - dir, mid + dir);
+                    let third = mid + DVec3::Z * 0.1;
+                    let normal = (b - a).cross(third - a);
+                    let e = SceneEdge {
+                        a,
+                        b,
+                        faces: vec![EdgeFace {
+                            third,
+                            normal,
+                            offset: -normal.dot(a),
+                            weight: 1,
+                            two_sided: true,
+                        }],
+                        always: true,
+                    };
+                    let ce = CentredEdge::new(&e, c);
+                    let pc = p - c;
+                    PlanarEdge::new(&e, c, u, v).test(
+                        pc.as_vec3(),
+                        pc.length() as f32 * 2.0,
+                        || ce.orientation(pc),
+                    )
+                })
+                .collect();
+            let mut four = [PlanarTest::NONE; 4];
+            four[..tests.len()].copy_from_slice(&tests);
+            let ranges = QuadRanges::of_tests(&four);
+            for (j, t) in tests.iter().enumerate() {
+                let exact = t.covered_word(&samples, 0);
+                let cand = index.quad_word(&ranges, j);
+                let mut slice = [0u64];
+                index.quad_candidates(&ranges, j, &[u64::MAX], &mut slice);
+                assert_eq!(
+                    slice[0], cand,
+                    "case {k} test {j}: one word and slices differ"
+                );
+                assert_eq!(
+                    exact & !cand,
+                    0,
+                    "case {k} test {j}: a covered sample is no candidate"
+                );
+                assert_eq!(
+                    t.covered_of(samples.first_word_x(), samples.first_word_y(), cand),
+                    exact
+                );
+                covered += exact.count_ones();
+                candidates += cand.count_ones();
+                total += 64;
+            }
+        }
+        assert!(covered > 1000, "{covered}");
+        assert!(candidates < total / 8, "{candidates} of {total}");
+    }
 }

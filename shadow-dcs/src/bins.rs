@@ -22,6 +22,7 @@
 //! the lanes would keep.
 
 use glam::{BVec4A, DVec3, Vec3, Vec4};
+use rayon::prelude::*;
 
 use crate::centred::FastWeight;
 use crate::centred::{CentredEdge, CentredPlane};
@@ -249,6 +250,69 @@ pub(crate) fn blocks(width: u32, height: u32) -> Vec<(Rect, Vec<Rect>)> {
     grid((0, width - 1), (0, height - 1), BLOCK)
         .map(|b| (b, grid(b.cols, b.rows, SQUARE).collect()))
         .collect()
+}
+
+/// The first level of the hierarchy for a frame: which blocks' boxes keep each wedge.
+pub(crate) struct BlockWedges {
+    /// Per wedge, one mask word per group of [`BOXES`] blocks.
+    masks: Vec<u64>,
+    groups: usize,
+}
+
+impl BlockWedges {
+    /// Every wedge against the boxes of `blocks`, [`BOXES`] blocks per test, in parallel.
+    pub fn new(input: &ScanInput, blocks: &[(Rect, Vec<Rect>)]) -> Self {
+        let groups: Vec<Boxes> = blocks
+            .chunks(BOXES)
+            .map(|g| {
+                let mut b = Boxes::default();
+                b.set(
+                    g.iter()
+                        .map(|(r, _)| rect_box(*r, input.width, input.centred, input.active)),
+                );
+                b
+            })
+            .collect();
+        let masks = input
+            .wedges
+            .par_iter()
+            .flat_map_iter(|w| groups.iter().map(move |g| g.test(w, input.slack)))
+            .collect();
+        Self {
+            masks,
+            groups: groups.len(),
+        }
+    }
+
+    /// The second level for block `block` (with squares `squares`): the wedges its box keeps
+    /// against its squares' boxes. Returns each square's wedges (silhouette indices in order)
+    /// and the number of wedges the block kept.
+    pub fn square_lists(
+        &self,
+        input: &ScanInput,
+        block: usize,
+        squares: &[Rect],
+    ) -> (Vec<Vec<u32>>, usize) {
+        let (g, bit) = (block / BOXES, block % BOXES);
+        let mut sq = Boxes::default();
+        sq.set(
+            squares
+                .iter()
+                .map(|r| rect_box(*r, input.width, input.centred, input.active)),
+        );
+        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); squares.len()];
+        let mut kept = 0;
+        for wi in 0..input.wedges.len() {
+            if self.masks[wi * self.groups + g] >> bit & 1 == 0 {
+                continue;
+            }
+            kept += 1;
+            for s in bits_of(sq.test(&input.wedges[wi], input.slack)) {
+                lists[s].push(wi as u32);
+            }
+        }
+        (lists, kept)
+    }
 }
 
 /// The box of the active light-centred view samples of `rect`, `None` when it has none.
@@ -491,6 +555,94 @@ pub(crate) fn square_pairs(
         if !found_tests.is_empty() {
             out.tests
                 .extend(order.iter().map(|&f| found_tests[f as usize]));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::edges::{Silhouettes, scene_edges, silhouettes};
+    use crate::light_shape::LightShape;
+    use crate::wedges::{FOLD_SLACK, wedges};
+    use shadow_core::offset::RayOffset;
+    use shadow_core::prelude::*;
+
+    /// The box hierarchy finds exactly the (pixel, wedge, weight) pairs of a brute-force scan
+    /// of every view sample against every wedge (inside the bounding planes, non-zero exact
+    /// weight): no box test drops a pair.
+    #[test]
+    fn the_hierarchy_finds_every_pair_of_the_brute_force_scan() {
+        for (name, w, h) in [("bunny", 40, 30), ("overlapping-occluders", 70, 52)] {
+            let setup = shadow_core::scenes::builtin(name).unwrap();
+            let scene = setup.scene.as_ref();
+            let view = ViewSamples::render(scene, &setup.camera_or_default(), w, h).unwrap();
+            let light = setup.lights[0].as_ref();
+            let shape = LightShape::new(light, "test").unwrap();
+            let (edges, _) = scene_edges(scene, shape.center);
+            let sil = silhouettes(&edges, &shape, Silhouettes::Accurate);
+            let ws = wedges(&edges, &sil, &shape);
+            let scan: Vec<ScanWedge> = ws.iter().map(|w| ScanWedge::new(w, None)).collect();
+            let extent = scene.bounds().union(light.bounds()).diagonal();
+            let offset = RayOffset::for_extent(extent);
+            let c = shape.center.as_dvec3();
+            let n = view.len();
+            let (mut origins, mut centred, mut active) =
+                (vec![Vec3::ZERO; n], vec![Vec3::ZERO; n], vec![false; n]);
+            for i in 0..n {
+                if let Some(s) = view.get(i) {
+                    origins[i] = offset.offset(s.position, s.geometric_normal);
+                    centred[i] = (origins[i].as_dvec3() - c).as_vec3();
+                    active[i] = true;
+                }
+            }
+            let input = ScanInput {
+                edges: &edges,
+                wedges: &scan,
+                c,
+                width: w,
+                origins: &origins,
+                centred: &centred,
+                active: &active,
+                slack: (FOLD_SLACK * extent as f64) as f32,
+                planar: None,
+            };
+            let blocks = blocks(w, h);
+            let levels = BlockWedges::new(&input, &blocks);
+            let mut found = Vec::new();
+            let (mut pairs, mut scratch) = (SquarePairs::default(), SquareScratch::default());
+            for (bi, (_, squares)) in blocks.iter().enumerate() {
+                let (lists, _) = levels.square_lists(&input, bi, squares);
+                for (r, list) in squares.iter().zip(&lists) {
+                    square_pairs(&input, list, *r, &mut pairs, &mut scratch);
+                    for (j, x, y) in pairs.pixels() {
+                        let i = (y * w + x) as usize;
+                        found.extend(pairs.of(j).0.iter().map(|p| (i, p.edge, p.k)));
+                    }
+                }
+            }
+            // Brute force: every active view sample against every wedge.
+            let mut want = Vec::new();
+            for i in 0..n {
+                if !active[i] {
+                    continue;
+                }
+                let q = TileLanes::at(centred[i]).quads();
+                for (wi, sw) in scan.iter().enumerate() {
+                    if sw.inside(&q, 1) == 0 {
+                        continue;
+                    }
+                    let e = &edges[sw.edge as usize];
+                    match e.sweep_weight(origins[i].as_dvec3(), c, false) {
+                        Some(k) if k != 0 => want.push((i, wi as u32, k as i32)),
+                        _ => {}
+                    }
+                }
+            }
+            found.sort_unstable();
+            want.sort_unstable();
+            assert!(want.len() > 500, "{name}: {} pairs", want.len());
+            assert_eq!(found, want, "{name}");
         }
     }
 }

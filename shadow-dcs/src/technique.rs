@@ -39,8 +39,7 @@ use shadow_core::visibility::{PerSampleVisibility, PixelClass};
 
 use crate::angular::{AngularIndex, BATCH, QuadRanges};
 use crate::bins::{
-    BOXES, Boxes, Rect, ScanInput, ScanWedge, SquarePairs, SquareScratch, bits_of, rect_box,
-    square_pairs,
+    BlockWedges, Rect, ScanInput, ScanWedge, SquarePairs, SquareScratch, square_pairs,
 };
 use crate::centred::CentredEdge;
 use crate::constant::{eye_constant, integration_constants};
@@ -454,48 +453,14 @@ impl Dcs {
         work: impl Fn(Rect, &[u32], &mut StripBuffers) -> T + Sync + Send,
     ) -> (Vec<(Rect, T)>, u64) {
         let view = f.view;
-        let slack = (FOLD_SLACK * p.extent) as f32;
-        let width = view.width();
-        let blocks = crate::bins::blocks(width, view.height());
-        // Every wedge against the block boxes, up to 64 blocks per test.
-        let groups: Vec<Boxes> = blocks
-            .chunks(BOXES)
-            .map(|g| {
-                let mut b = Boxes::default();
-                b.set(
-                    g.iter()
-                        .map(|(r, _)| rect_box(*r, width, &f.centred, &f.active)),
-                );
-                b
-            })
-            .collect();
-        let masks: Vec<u64> = p
-            .scan
-            .par_iter()
-            .flat_map_iter(|w| groups.iter().map(move |g| g.test(w, slack)))
-            .collect();
-        let ng = groups.len();
+        let input = Self::scan_input(p, f);
+        let blocks = crate::bins::blocks(view.width(), view.height());
+        let levels = BlockWedges::new(&input, &blocks);
         let parts: Vec<(Vec<(Rect, T)>, u64)> = blocks
             .par_iter()
             .enumerate()
             .map(|(bi, (_, squares))| {
-                let (g, bit) = (bi / BOXES, bi % BOXES);
-                let kept: Vec<u32> = (0..p.scan.len() as u32)
-                    .filter(|&wi| masks[wi as usize * ng + g] >> bit & 1 == 1)
-                    .collect();
-                // The block's wedges against its squares' boxes.
-                let mut sq = Boxes::default();
-                sq.set(
-                    squares
-                        .iter()
-                        .map(|r| rect_box(*r, width, &f.centred, &f.active)),
-                );
-                let mut lists: Vec<Vec<u32>> = vec![Vec::new(); squares.len()];
-                for &wi in &kept {
-                    for s in bits_of(sq.test(&p.scan[wi as usize], slack)) {
-                        lists[s].push(wi);
-                    }
-                }
+                let (lists, kept) = levels.square_lists(&input, bi, squares);
                 let out = squares
                     .par_iter()
                     .zip(&lists)
@@ -503,7 +468,7 @@ impl Dcs {
                         (r, work(r, list, buffers))
                     })
                     .collect();
-                (out, kept.len() as u64)
+                (out, kept as u64)
             })
             .collect();
         let kept = parts.iter().map(|(_, k)| k).sum();

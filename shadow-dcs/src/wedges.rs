@@ -4,7 +4,7 @@
 //! The wedge of edge `e` is the set of points `x + t (x - y)`, `x` on the edge, `y` on the
 //! light, `t > 0`: the points `z` whose segment to some light point crosses the edge. It is the
 //! union over `x` on the edge of the anti-cones `K_x = {x + t (x - y)}` of the light, and lies in
-//! the intersection of half-spaces bounded by ([`wedge_planes`], prepared once per light):
+//! the intersection of half-spaces bounded by (`wedge_planes`, prepared once per light):
 //! * the planes through the edge's line that support the light (the classic wedge planes of
 //!   AAM03): the light on one side, every `K_x` on the other;
 //! * for a planar light, the planes through an end point `v` and a side of the light's polygon
@@ -14,10 +14,10 @@
 //!   away from the light.
 //!
 //! A view sample outside any of these planes sees no part of the light through the edge. The
-//! view samples inside each wedge are found by the box hierarchy of [`crate::bins`] (the spatial
+//! view samples inside each wedge are found by the box hierarchy of `bins` (the spatial
 //! structure that plays the part of the GPU's rasterization of wedges); each gets the exact
 //! weight `k_e(p)` (`SceneEdge::sweep_weight`, or its single-precision form with an error bound,
-//! [`crate::centred::FastWeight`]), and only view samples with a non-zero weight are kept. The
+//! `centred::FastWeight`), and only view samples with a non-zero weight are kept. The
 //! shadow-volume quad splits the wedge: `k_e > 0` is the outer part (samples beyond the projected
 //! edge gain depth complexity), `k_e < 0` the inner part.
 
@@ -242,4 +242,110 @@ pub(crate) fn convex_hull(mut p: Vec<DVec2>) -> Vec<DVec2> {
     }
     hull.pop();
     hull
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::coverage::EdgeTest;
+    use crate::edges::EdgeFace;
+    use glam::Vec3;
+    use shadow_core::light::{
+        AreaLight, DiskLight, PolygonLight, Radiance, RectLight, SphereLight,
+    };
+    use shadow_core::sampling::{hash_words, unit_float};
+
+    /// A view sample from which the edge covers any point of the light lies inside every
+    /// bounding plane of the wedge (rectangle, disk, polygon and sphere lights; view samples
+    /// all around, some far from the origin): the planes never drop a pair that matters.
+    #[test]
+    fn wedge_planes_hold_every_view_sample_that_sees_the_edge_over_the_light() {
+        let white = || Radiance::constant(Vec3::ONE).unwrap();
+        let (mut inside_covering, mut outside) = (0, 0);
+        for k in 0..1500u64 {
+            let r = |i: u64| unit_float(hash_words(&[k, i])) * 2.0 - 1.0;
+            let o = Vec3::splat([0.0, 1e3][k as usize % 2]);
+            let c = o + Vec3::new(r(0), 3.0 + r(1) * 0.3, r(2));
+            let light: Box<dyn AreaLight> = match k % 4 {
+                0 => Box::new(
+                    RectLight::facing(
+                        c,
+                        Vec3::new(r(3) * 0.3, -1.0, r(4) * 0.3),
+                        1.0 + r(5),
+                        0.8,
+                        white(),
+                    )
+                    .unwrap(),
+                ),
+                1 => Box::new(DiskLight::new(c, Vec3::NEG_Y, 0.7 + 0.3 * r(5), white()).unwrap()),
+                2 => Box::new(
+                    PolygonLight::new(
+                        (0..5)
+                            .map(|j| {
+                                let a = -(j as f32) * std::f32::consts::TAU / 5.0;
+                                c + Vec3::new(a.cos(), 0.0, a.sin()) * (0.6 + 0.2 * r(6 + j))
+                            })
+                            .collect(),
+                        white(),
+                    )
+                    .unwrap(),
+                ),
+                _ => Box::new(SphereLight::new(c, 0.4 + 0.2 * r(5), white()).unwrap()),
+            };
+            let shape = LightShape::new(light.as_ref(), "test").unwrap();
+            let mid = o + Vec3::new(r(7), 1.6 + r(8) * 0.8, r(9));
+            let dir = Vec3::new(r(10), r(11) * 0.5, r(12)) * 0.4;
+            let (a, b) = ((mid - dir).as_dvec3(), (mid + dir).as_dvec3());
+            let third = (mid + Vec3::new(r(13), r(14), r(15)) * 0.3).as_dvec3();
+            let normal = (b - a).cross(third - a);
+            let e = SceneEdge {
+                a,
+                b,
+                faces: vec![EdgeFace {
+                    third,
+                    normal,
+                    offset: -normal.dot(a),
+                    weight: 1,
+                    two_sided: true,
+                }],
+                always: true,
+            };
+            let planes = wedge_planes(&e, &shape);
+            let cd = shape.center.as_dvec3();
+            for j in 0..40u64 {
+                let p = o.as_dvec3()
+                    + glam::DVec3::new(
+                        r(20 + 3 * j) as f64 * 4.0,
+                        r(21 + 3 * j) as f64 * 0.5,
+                        r(22 + 3 * j) as f64 * 4.0,
+                    );
+                let inside = planes.iter().all(|q| q.n.dot(p) + q.d >= 0.0);
+                let Some(t) = EdgeTest::new(p, cd, a, b) else {
+                    continue;
+                };
+                // Points of the light on a grid of its unit square.
+                let n = 24;
+                let covers = (0..n * n).any(|g| {
+                    let u = glam::Vec2::new(
+                        ((g % n) as f32 + 0.5) / n as f32,
+                        ((g / n) as f32 + 0.5) / n as f32,
+                    );
+                    let s = light.sample(u).position.as_dvec3();
+                    t.covers_offset((s - p).as_vec3())
+                });
+                if covers {
+                    assert!(
+                        inside,
+                        "case {k} view sample {j}: a covering edge outside a plane"
+                    );
+                    inside_covering += 1;
+                } else if !inside {
+                    outside += 1;
+                }
+            }
+        }
+        assert!(inside_covering > 500, "{inside_covering}");
+        // The planes do reject view samples.
+        assert!(outside > 5000, "{outside}");
+    }
 }
