@@ -25,6 +25,18 @@ pub(crate) struct Packed {
     planes: Vec<u64>,
 }
 
+/// One bit word of an addition: the sum and the carry out.
+#[inline(always)]
+fn add_step(x: u64, carry: u64) -> (u64, u64) {
+    (x ^ carry, x & carry)
+}
+
+/// One bit word of a subtraction: the difference and the borrow out.
+#[inline(always)]
+fn sub_step(x: u64, borrow: u64) -> (u64, u64) {
+    (x ^ borrow, !x & borrow)
+}
+
 /// The first `n - 64 w` bits of word `w` (the samples that exist).
 #[inline]
 fn valid(n: usize, w: usize) -> u64 {
@@ -64,49 +76,74 @@ impl Packed {
 
     /// Adds `k` to every counter whose bit is set in `mask`.
     pub fn add(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
-        self.update(mask, k, |x, carry| (x ^ carry, x & carry))
+        self.update(mask, k, add_step)
     }
 
     /// Subtracts `k` from every counter whose bit is set in `mask`.
     pub fn sub(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
-        self.update(mask, k, |x, borrow| (x ^ borrow, !x & borrow))
+        self.update(mask, k, sub_step)
     }
 
-    /// Adds or subtracts (`step(bit word, carry) -> (new word, carry out)`) `k` times the
-    /// samples of `mask`: for each set bit `b` of `k`, a ripple from bit word `b` up. Stops at
-    /// the first carry out of the top bit; the counters are then partly updated, and the caller
-    /// starts the pixel again.
+    /// [`Packed::add`] for counters that fit one word of samples (`n <= 64`).
+    #[inline]
+    pub fn add_one(&mut self, mask: u64, k: u64) -> Result<(), OutOfRange> {
+        self.update_word(0, mask, k, add_step)
+    }
+
+    /// [`Packed::sub`] for counters that fit one word of samples (`n <= 64`).
+    #[inline]
+    pub fn sub_one(&mut self, mask: u64, k: u64) -> Result<(), OutOfRange> {
+        self.update_word(0, mask, k, sub_step)
+    }
+
+    /// Adds or subtracts `k` times the samples of `mask`, word by word.
     #[inline]
     fn update(
         &mut self,
         mask: &[u64],
+        k: u64,
+        step: impl Fn(u64, u64) -> (u64, u64) + Copy,
+    ) -> Result<(), OutOfRange> {
+        for (w, &m) in mask.iter().enumerate().take(self.n.div_ceil(64)) {
+            self.update_word(w, m, k, step)?;
+        }
+        Ok(())
+    }
+
+    /// Adds or subtracts (`step(bit word, carry) -> (new word, carry out)`) `k` times the
+    /// samples `m` of word `w`: for each set bit `b` of `k`, a ripple from bit word `b` up.
+    /// Stops at the first carry out of the top bit; the counters are then partly updated, and
+    /// the caller starts the pixel again.
+    #[inline(always)]
+    fn update_word(
+        &mut self,
+        w: usize,
+        m: u64,
         k: u64,
         step: impl Fn(u64, u64) -> (u64, u64),
     ) -> Result<(), OutOfRange> {
         if k > Self::lane_max(self.bits) {
             return Err(OutOfRange);
         }
+        let m = m & valid(self.n, w);
+        if m == 0 {
+            return Ok(());
+        }
         let bits = self.bits as usize;
-        for (w, &m) in mask.iter().enumerate().take(self.n.div_ceil(64)) {
-            let m = m & valid(self.n, w);
-            if m == 0 {
-                continue;
+        let planes = &mut self.planes[w * bits..(w + 1) * bits];
+        let mut todo = k;
+        while todo != 0 {
+            let b = todo.trailing_zeros() as usize;
+            todo &= todo - 1;
+            let mut carry = m;
+            for x in &mut planes[b..] {
+                (*x, carry) = step(*x, carry);
+                if carry == 0 {
+                    break;
+                }
             }
-            let planes = &mut self.planes[w * bits..(w + 1) * bits];
-            let mut todo = k;
-            while todo != 0 {
-                let b = todo.trailing_zeros() as usize;
-                todo &= todo - 1;
-                let mut carry = m;
-                for x in &mut planes[b..] {
-                    (*x, carry) = step(*x, carry);
-                    if carry == 0 {
-                        break;
-                    }
-                }
-                if carry != 0 {
-                    return Err(OutOfRange);
-                }
+            if carry != 0 {
+                return Err(OutOfRange);
             }
         }
         Ok(())
@@ -213,7 +250,12 @@ mod tests {
                             }
                         }
                     }
-                    let done = if up { p.add(&m, 1) } else { p.sub(&m, 1) };
+                    let done = match (n, up) {
+                        (64, true) => p.add_one(m[0], 1),
+                        (64, false) => p.sub_one(m[0], 1),
+                        (_, true) => p.add(&m, 1),
+                        (_, false) => p.sub(&m, 1),
+                    };
                     assert!(done.is_ok());
                     for i in 0..n {
                         if m[i / 64] >> (i % 64) & 1 == 1 {

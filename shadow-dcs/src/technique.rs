@@ -1064,6 +1064,20 @@ fn run_packed(
 ) -> Result<(), crate::counters::OutOfRange> {
     packed.reset(bits, n, d0)?;
     let words = n.div_ceil(64);
+    if words == 1 {
+        // One word of samples: plain words, outer wedges first.
+        for (&m, &k) in masks.iter().zip(weights) {
+            if k > 0 {
+                packed.add_one(m, k as u64)?;
+            }
+        }
+        for (&m, &k) in masks.iter().zip(weights) {
+            if k < 0 {
+                packed.sub_one(m, k.unsigned_abs())?;
+            }
+        }
+        return Ok(());
+    }
     for outer in [true, false] {
         for (m, &k) in masks.chunks(words).zip(weights) {
             if (k > 0) != outer {
