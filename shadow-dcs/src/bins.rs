@@ -41,7 +41,7 @@ pub(crate) const SQUARE: u32 = 16;
 
 /// Bounding planes per wedge in the box tests: more are dropped (any subset of a wedge's
 /// bounding planes bounds it).
-const BOX_PLANES: usize = 6;
+const BOX_PLANES: usize = 10;
 
 /// Relative padding of a box, far above the rounding of its centre and of a plane evaluated there.
 const BOX_PAD: f32 = 1e-6;

@@ -1,198 +1,106 @@
-//! Packed depth-complexity counters (DCS sections 4.3, 4.4 and 5.3), bit-sliced: the counters
-//! of 64 light samples share `bits` words, word `b` holding bit `b` of every counter, so that
-//! one update adds a mask of samples to all of them with a ripple of word operations (a carry
-//! or borrow mask per bit). This is the CPU form of the paper's packing (Fig. 3 adds four
-//! byte-wide counters with one 32-bit addition; here a `bits`-deep ripple updates 64 counters,
-//! usually stopping after a bit or two). The precision is chosen per frame from the largest
-//! integration constant (section 5.3); an update that would carry out of the top bit
-//! (overflow) or borrow past it (underflow) is detected and reported, never wrapped, and the
-//! caller redoes the pixel with more bits. Which samples have depth complexity zero (the
-//! visibility of eq. 1 and 5) is the complement of the union of the bit words.
+//! Packed depth-complexity counters (DCS sections 4.3, 4.4 and 5.3): one unsigned counter per
+//! light sample, many sharing a machine word, updated by a whole mask of samples at once. The
+//! precision is chosen per frame from the largest integration constant (section 5.3); an update
+//! that would leave the counters' range is detected and reported, never wrapped, and the caller
+//! redoes the pixel with wider counters (or, past the widest, plain signed ones).
+//!
+//! Two packings share that contract:
+//! * [`Packed`]: the paper's (Fig. 3), several counters in the lanes of a word, one addition
+//!   each; reading a counter back is a shift and a mask;
+//! * [`BitSliced`]: bit `b` of 64 counters in one word, an update a ripple of word operations;
+//!   the zero counters (the visible samples) come out as one mask.
+//!
+//! The technique takes the bit-sliced form when it needs only which samples are visible and the
+//! paper's form when it reads every depth complexity.
+
+mod packed;
+mod sliced;
+
+pub(crate) use packed::Packed;
+pub(crate) use sliced::BitSliced;
 
 /// An update would leave the counters' range.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct OutOfRange;
 
-/// Counter precisions tried in turn (bits), the narrowest first; 64 bits hold any count.
-pub(crate) const WIDTHS: [u32; 4] = [8, 16, 32, 64];
+/// Counter precisions tried in turn (bits), the narrowest first.
+pub(crate) const WIDTHS: [u32; 3] = [8, 16, 32];
 
-/// Counters for `n` samples, `bits` bits each.
-#[derive(Debug, Clone, Default)]
-pub(crate) struct Packed {
-    bits: u32,
-    n: usize,
-    /// Word `w * bits + b`: bit `b` of the counters of samples `64 w .. 64 w + 64`.
-    planes: Vec<u64>,
-}
-
-/// One bit word of an addition: the sum and the carry out.
-#[inline(always)]
-fn add_step(x: u64, carry: u64) -> (u64, u64) {
-    (x ^ carry, x & carry)
-}
-
-/// One bit word of a subtraction: the difference and the borrow out.
-#[inline(always)]
-fn sub_step(x: u64, borrow: u64) -> (u64, u64) {
-    (x ^ borrow, !x & borrow)
-}
-
-/// The first `n - 64 w` bits of word `w` (the samples that exist).
-#[inline]
-fn valid(n: usize, w: usize) -> u64 {
-    let left = n - 64 * w;
-    if left >= 64 {
+/// Largest value a counter of `bits` bits holds.
+pub(crate) fn lane_max(bits: u32) -> u64 {
+    if bits >= 64 {
         u64::MAX
     } else {
-        (1 << left) - 1
+        (1u64 << bits) - 1
     }
 }
 
-impl Packed {
-    /// Largest value a counter of `bits` bits holds.
-    pub fn lane_max(bits: u32) -> u64 {
-        if bits >= 64 {
-            u64::MAX
-        } else {
-            (1u64 << bits) - 1
-        }
-    }
-
-    /// Resets to `n` counters of `bits` bits, all holding `init`.
-    pub fn reset(&mut self, bits: u32, n: usize, init: u64) -> Result<(), OutOfRange> {
-        if init > Self::lane_max(bits) {
-            return Err(OutOfRange);
-        }
-        self.bits = bits;
-        self.n = n;
-        self.planes.clear();
-        for w in 0..n.div_ceil(64) {
-            let v = valid(n, w);
-            self.planes
-                .extend((0..bits).map(|b| if init >> b & 1 == 1 { v } else { 0 }));
-        }
-        Ok(())
-    }
-
-    /// Adds `k` to every counter whose bit is set in `mask`.
-    pub fn add(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
-        self.update(mask, k, add_step)
-    }
-
-    /// Subtracts `k` from every counter whose bit is set in `mask`.
-    pub fn sub(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
-        self.update(mask, k, sub_step)
-    }
-
-    /// [`Packed::add`] for counters that fit one word of samples (`n <= 64`).
-    #[inline]
-    pub fn add_one(&mut self, mask: u64, k: u64) -> Result<(), OutOfRange> {
-        self.update_word(0, mask, k, add_step)
-    }
-
-    /// [`Packed::sub`] for counters that fit one word of samples (`n <= 64`).
-    #[inline]
-    pub fn sub_one(&mut self, mask: u64, k: u64) -> Result<(), OutOfRange> {
-        self.update_word(0, mask, k, sub_step)
-    }
-
-    /// Adds or subtracts `k` times the samples of `mask`, word by word.
-    #[inline]
-    fn update(
-        &mut self,
-        mask: &[u64],
-        k: u64,
-        step: impl Fn(u64, u64) -> (u64, u64) + Copy,
-    ) -> Result<(), OutOfRange> {
-        for (w, &m) in mask.iter().enumerate().take(self.n.div_ceil(64)) {
-            self.update_word(w, m, k, step)?;
-        }
-        Ok(())
-    }
-
-    /// Adds or subtracts (`step(bit word, carry) -> (new word, carry out)`) `k` times the
-    /// samples `m` of word `w`: for each set bit `b` of `k`, a ripple from bit word `b` up.
-    /// Stops at the first carry out of the top bit; the counters are then partly updated, and
-    /// the caller starts the pixel again.
-    #[inline(always)]
-    fn update_word(
-        &mut self,
-        w: usize,
-        m: u64,
-        k: u64,
-        step: impl Fn(u64, u64) -> (u64, u64),
-    ) -> Result<(), OutOfRange> {
-        if k > Self::lane_max(self.bits) {
-            return Err(OutOfRange);
-        }
-        let m = m & valid(self.n, w);
-        if m == 0 {
-            return Ok(());
-        }
-        let bits = self.bits as usize;
-        let planes = &mut self.planes[w * bits..(w + 1) * bits];
-        let mut todo = k;
-        while todo != 0 {
-            let b = todo.trailing_zeros() as usize;
-            todo &= todo - 1;
-            let mut carry = m;
-            for x in &mut planes[b..] {
-                (*x, carry) = step(*x, carry);
-                if carry == 0 {
-                    break;
-                }
-            }
-            if carry != 0 {
-                return Err(OutOfRange);
-            }
-        }
-        Ok(())
-    }
-
-    /// Appends every counter, in order, to `out`.
-    pub fn unpack_into(&self, out: &mut Vec<u64>) {
-        let bits = self.bits as usize;
-        for i in 0..self.n {
-            let planes = &self.planes[(i / 64) * bits..(i / 64 + 1) * bits];
-            let v = planes
-                .iter()
-                .enumerate()
-                .fold(0u64, |v, (b, x)| v | ((x >> (i % 64)) & 1) << b);
-            out.push(v);
-        }
-    }
-
-    /// Sets bit `i` of `out` (whole words) for every counter `i` that is zero, clears the rest.
-    pub fn zero_mask_into(&self, out: &mut [u64]) {
-        let bits = self.bits as usize;
-        for (w, o) in out.iter_mut().enumerate() {
-            *o = if w < self.n.div_ceil(64) {
-                let any = self.planes[w * bits..(w + 1) * bits]
-                    .iter()
-                    .fold(0, |a, x| a | x);
-                !any & valid(self.n, w)
-            } else {
-                0
-            };
-        }
-    }
-
-    /// Counter `i`.
-    #[cfg(test)]
-    pub fn get(&self, i: usize) -> u64 {
-        let mut all = Vec::new();
-        self.unpack_into(&mut all);
-        all[i]
-    }
-}
-
-/// The narrowest precision of [`WIDTHS`] whose range holds twice `max_constant` (section
-/// 5.3, with headroom for penumbra samples deeper than the centre).
+/// The narrowest precision of [`WIDTHS`] whose range holds twice `max_constant` (section 5.3,
+/// with headroom for penumbra samples deeper than the centre).
 pub(crate) fn width_for(max_constant: u64) -> u32 {
     WIDTHS
         .into_iter()
-        .find(|&b| max_constant.saturating_mul(2) < Packed::lane_max(b))
-        .unwrap_or(64)
+        .find(|&b| max_constant.saturating_mul(2) < lane_max(b))
+        .unwrap_or(32)
+}
+
+/// What the update loop needs of a packing.
+pub(crate) trait Counters {
+    /// `n` counters of `bits` bits, all holding `init`.
+    fn reset(&mut self, bits: u32, n: usize, init: u64) -> Result<(), OutOfRange>;
+    /// Adds `k` to every counter whose bit is set in `mask`.
+    fn add(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange>;
+    /// Subtracts `k` from every counter whose bit is set in `mask`.
+    fn sub(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange>;
+    /// [`Counters::add`] for counters that fit one word of samples.
+    fn add_one(&mut self, mask: u64, k: u64) -> Result<(), OutOfRange> {
+        self.add(&[mask], k)
+    }
+    /// [`Counters::sub`] for counters that fit one word of samples.
+    fn sub_one(&mut self, mask: u64, k: u64) -> Result<(), OutOfRange> {
+        self.sub(&[mask], k)
+    }
+}
+
+/// Applies the updates (`masks`, `words` per update, and their weights) to counters of `bits`
+/// bits starting at `d0`, outer wedges (`k > 0`) before inner ones (section 4.4), so that no
+/// counter dips below zero on the way to a final value that does not.
+pub(crate) fn run<C: Counters>(
+    counters: &mut C,
+    bits: u32,
+    n: usize,
+    d0: u64,
+    masks: &[u64],
+    weights: &[i64],
+) -> Result<(), OutOfRange> {
+    counters.reset(bits, n, d0)?;
+    let words = n.div_ceil(64);
+    if words == 1 {
+        for (&m, &k) in masks.iter().zip(weights) {
+            if k > 0 {
+                counters.add_one(m, k as u64)?;
+            }
+        }
+        for (&m, &k) in masks.iter().zip(weights) {
+            if k < 0 {
+                counters.sub_one(m, k.unsigned_abs())?;
+            }
+        }
+        return Ok(());
+    }
+    for outer in [true, false] {
+        for (m, &k) in masks.chunks(words).zip(weights) {
+            if (k > 0) != outer {
+                continue;
+            }
+            if k > 0 {
+                counters.add(m, k as u64)?;
+            } else {
+                counters.sub(m, k.unsigned_abs())?;
+            }
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -200,110 +108,45 @@ mod tests {
     use super::*;
 
     #[test]
-    fn packed_updates_match_plain_counters() {
-        for bits in WIDTHS {
-            for n in [5usize, 64, 100] {
-                let mut p = Packed::default();
-                p.reset(bits, n, 3).unwrap();
-                let mut plain = vec![3u64; n];
-                let mut state = 12345u64;
-                for step in 0..50 {
-                    state = shadow_core::sampling::mix64(state);
-                    let mask = [state, shadow_core::sampling::mix64(state ^ 7)];
-                    let k = 1 + step % 3;
-                    p.add(&mask, k).unwrap();
-                    for i in 0..n {
-                        if mask[i / 64] >> (i % 64) & 1 == 1 {
-                            plain[i] += k;
-                        }
-                    }
-                }
-                for i in 0..n {
-                    assert_eq!(p.get(i), plain[i], "bits {bits} counter {i}");
-                }
-                let mut all = Vec::new();
-                p.unpack_into(&mut all);
-                assert_eq!(all, plain, "bits {bits}: unpacked");
-            }
-        }
-    }
-
-    #[test]
-    fn zero_masks_match_the_counters() {
-        for bits in WIDTHS {
-            for n in [5usize, 64, 100] {
-                let mut p = Packed::default();
-                p.reset(bits, n, 1).unwrap();
-                let mut plain = vec![1i64; n];
-                let mut state = 99u64;
-                let mut zeros = 0;
-                for step in 0..20 {
-                    state = shadow_core::sampling::mix64(state);
-                    let mut m = [state, shadow_core::sampling::mix64(state ^ 3)];
-                    let up = step % 2 == 1;
-                    if !up {
-                        // Only counters above zero go down (a failed update may have changed
-                        // some words: the technique redoes such a pixel from the start).
-                        for i in 0..n {
-                            if plain[i] == 0 {
-                                m[i / 64] &= !(1 << (i % 64));
-                            }
-                        }
-                    }
-                    let done = match (n, up) {
-                        (64, true) => p.add_one(m[0], 1),
-                        (64, false) => p.sub_one(m[0], 1),
-                        (_, true) => p.add(&m, 1),
-                        (_, false) => p.sub(&m, 1),
-                    };
-                    assert!(done.is_ok());
-                    for i in 0..n {
-                        if m[i / 64] >> (i % 64) & 1 == 1 {
-                            plain[i] += if up { 1 } else { -1 };
-                        }
-                    }
-                    let mut zero = [0u64; 2];
-                    p.zero_mask_into(&mut zero);
-                    for i in 0..128 {
-                        let got = zero[i / 64] >> (i % 64) & 1 == 1;
-                        assert_eq!(
-                            got,
-                            i < n && plain[i] == 0,
-                            "bits {bits} n {n} step {step} counter {i}"
-                        );
-                        zeros += usize::from(got);
-                    }
-                }
-                assert!(zeros > 0, "bits {bits} n {n}: no zero reached");
-            }
-        }
-    }
-
-    #[test]
-    fn overflow_and_underflow_are_detected_not_wrapped() {
-        let mut p = Packed::default();
-        p.reset(8, 16, 250).unwrap();
-        let mask = [0b10u64];
-        p.add(&mask, 5).unwrap();
-        assert_eq!(p.get(1), 255);
-        assert_eq!(p.add(&mask, 1), Err(OutOfRange));
-        p.reset(16, 8, 1).unwrap();
-        p.sub(&[0b100], 1).unwrap();
-        assert_eq!(p.get(2), 0);
-        assert_eq!(p.sub(&[0b100], 1), Err(OutOfRange));
-        assert_eq!(p.get(3), 1);
-        assert!(p.reset(8, 4, 256).is_err());
-        // A weight wider than the counters is out of range too.
-        p.reset(8, 4, 0).unwrap();
-        assert_eq!(p.add(&[1], 256), Err(OutOfRange));
-        // Sixty-four bits hold the largest weights.
-        p.reset(64, 4, u64::MAX - 1).unwrap();
-        p.add(&[1], 1).unwrap();
-        assert_eq!(p.get(0), u64::MAX);
-        assert_eq!(p.add(&[1], 1), Err(OutOfRange));
+    fn widths_hold_twice_the_largest_constant() {
         assert_eq!(width_for(10), 8);
         assert_eq!(width_for(200), 16);
         assert_eq!(width_for(40_000), 32);
-        assert_eq!(width_for(u64::MAX / 2), 64);
+        assert_eq!(width_for(u64::MAX / 2), 32);
+    }
+
+    /// Both packings give the same counters and the same errors for the same updates.
+    #[test]
+    fn both_packings_agree() {
+        let mut state = 5u64;
+        for n in [16usize, 64, 100] {
+            for bits in WIDTHS {
+                let words = n.div_ceil(64);
+                let (mut masks, mut weights) = (Vec::new(), Vec::new());
+                for step in 0..40 {
+                    state = shadow_core::sampling::mix64(state);
+                    for w in 0..words {
+                        masks.push(shadow_core::sampling::mix64(state ^ w as u64));
+                    }
+                    weights.push([1i64, -1, 3, 255, -2][step % 5]);
+                }
+                let (mut p, mut s) = (Packed::default(), BitSliced::default());
+                let d0 = if bits == 8 { 40 } else { 600 };
+                let a = run(&mut p, bits, n, d0, &masks, &weights);
+                let b = run(&mut s, bits, n, d0, &masks, &weights);
+                assert_eq!(a, b, "n {n} bits {bits}");
+                if a.is_ok() {
+                    let (mut x, mut y) = (Vec::new(), Vec::new());
+                    p.unpack_into(&mut x);
+                    s.unpack_into(&mut y);
+                    assert_eq!(x, y, "n {n} bits {bits}");
+                    let mut zero = vec![0u64; words];
+                    s.zero_mask_into(&mut zero);
+                    for i in 0..n {
+                        assert_eq!(zero[i / 64] >> (i % 64) & 1 == 1, x[i] == 0);
+                    }
+                }
+            }
+        }
     }
 }

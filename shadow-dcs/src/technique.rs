@@ -43,7 +43,7 @@ use crate::bins::{
 };
 use crate::centred::CentredEdge;
 use crate::constant::{eye_constant, integration_constants};
-use crate::counters::{Packed, WIDTHS, width_for};
+use crate::counters::{self, BitSliced, Packed, WIDTHS, width_for};
 use crate::coverage::{EdgeTest, RelativePolygon, RelativeSamples};
 use crate::discrete::{CoveredSamples, DiscreteTables, LineMasks};
 use crate::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
@@ -193,6 +193,7 @@ struct Scratch {
     masks: Vec<u64>,
     weights: Vec<i64>,
     packed: Packed,
+    sliced: BitSliced,
     plain: Vec<i64>,
     /// Whether the caller reads each sample's visibility and depth complexity (`vis`,
     /// `depth`); without, only `visible` is set.
@@ -632,23 +633,21 @@ impl Dcs {
             };
         }
         counts.per_sample += 1;
-        // Packed counters, outer wedges (k > 0) before inner ones (section 4.4); wider lanes on
-        // overflow, plain signed counters as the last resort.
+        // Packed counters, outer wedges (k > 0) before inner ones (section 4.4); wider ones on
+        // overflow, plain signed counters as the last resort. Bit-sliced when only the zero
+        // counters are read, the paper's lanes when every depth complexity is.
         let mut done = false;
         for bits in WIDTHS.into_iter().filter(|&b| b >= f.bits) {
-            if run_packed(
-                &mut scratch.packed,
-                bits,
-                n,
-                d0,
-                &scratch.masks,
-                &scratch.weights,
-            )
-            .is_ok()
-            {
+            let (masks, weights) = (&scratch.masks, &scratch.weights);
+            let fits = if values {
+                counters::run(&mut scratch.packed, bits, n, d0, masks, weights)
+            } else {
+                counters::run(&mut scratch.sliced, bits, n, d0, masks, weights)
+            };
+            if fits.is_ok() {
                 if !values {
                     // Only which samples are visible: the zero counters above the horizon.
-                    scratch.packed.zero_mask_into(&mut scratch.visible);
+                    scratch.sliced.zero_mask_into(&mut scratch.visible);
                     let mut any = 0u64;
                     let mut all = true;
                     for (k, (v, a)) in scratch.visible.iter_mut().zip(&scratch.above).enumerate() {
@@ -1050,47 +1049,6 @@ fn fill_first(words: &mut [u64], n: usize) {
             (1 << left) - 1
         };
     }
-}
-
-/// Applies the updates with packed counters of `bits` bits.
-#[inline(never)]
-fn run_packed(
-    packed: &mut Packed,
-    bits: u32,
-    n: usize,
-    d0: u64,
-    masks: &[u64],
-    weights: &[i64],
-) -> Result<(), crate::counters::OutOfRange> {
-    packed.reset(bits, n, d0)?;
-    let words = n.div_ceil(64);
-    if words == 1 {
-        // One word of samples: plain words, outer wedges first.
-        for (&m, &k) in masks.iter().zip(weights) {
-            if k > 0 {
-                packed.add_one(m, k as u64)?;
-            }
-        }
-        for (&m, &k) in masks.iter().zip(weights) {
-            if k < 0 {
-                packed.sub_one(m, k.unsigned_abs())?;
-            }
-        }
-        return Ok(());
-    }
-    for outer in [true, false] {
-        for (m, &k) in masks.chunks(words).zip(weights) {
-            if (k > 0) != outer {
-                continue;
-            }
-            if k > 0 {
-                packed.add(m, k as u64)?;
-            } else {
-                packed.sub(m, k.unsigned_abs())?;
-            }
-        }
-    }
-    Ok(())
 }
 
 impl ShadowTechnique for Dcs {

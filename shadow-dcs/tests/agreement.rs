@@ -106,8 +106,17 @@ fn narrow_counters_overflow_into_wider_ones_without_changing_the_answer() {
     // Depth complexities beyond 255 survive: nothing wrapped.
     assert!(counts.iter().any(|&c| c >= 300 && c != u32::MAX));
     let mut r = same_samples_reference(&narrow);
-    r.prepare(scene, light).unwrap();
+    r.prepare(scene.clone(), light.clone()).unwrap();
     let truth = r.estimate(&view).unwrap().visibility;
+    let m = compare(&est.visibility, &truth).unwrap();
+    assert_eq!(m.sample_agreement, Some(1.0));
+    // The same with only the visible samples read (the bit-sliced counters).
+    let mut bits = Dcs::new(16, SamplingStrategy::Stratified, 2)
+        .unwrap()
+        .with_counter_bits(8);
+    bits.prepare(scene.clone(), light.clone()).unwrap();
+    let est = bits.estimate(&view).unwrap();
+    assert!(est.stats.counter("counter-escalations") > 0);
     let m = compare(&est.visibility, &truth).unwrap();
     assert_eq!(m.sample_agreement, Some(1.0));
 }
