@@ -565,7 +565,7 @@ mod tests {
     #[test]
     fn light_plane_candidates_hold_every_covered_sample() {
         use crate::centred::CentredEdge;
-        use crate::edges::{EdgeFace, SceneEdge};
+        use crate::edges::SceneEdge;
         use crate::planar::{PlanarEdge, PlanarSamples};
         let light = RectLight::facing(
             Vec3::new(0.2, 3.0, -0.1),
@@ -598,20 +598,7 @@ mod tests {
                     let mid = DVec3::new(r(2 + 8 * j), 1.5 + r(3 + 8 * j), r(4 + 8 * j));
                     let dir = DVec3::new(r(5 + 8 * j), r(6 + 8 * j) * 0.3, r(7 + 8 * j)) * 0.3;
                     let (a, b) = (mid - dir, mid + dir);
-                    let third = mid + DVec3::Z * 0.1;
-                    let normal = (b - a).cross(third - a);
-                    let e = SceneEdge {
-                        a,
-                        b,
-                        faces: vec![EdgeFace {
-                            third,
-                            normal,
-                            offset: -normal.dot(a),
-                            weight: 1,
-                            two_sided: true,
-                        }],
-                        always: true,
-                    };
+                    let e = SceneEdge::boundary(a, b, mid + DVec3::Z * 0.1);
                     let ce = CentredEdge::new(&e, c);
                     let pc = p - c;
                     PlanarEdge::new(&e, c, u, v).test(

@@ -5,9 +5,9 @@
 //! redoes the pixel with wider counters (or, past the widest, plain signed ones).
 //!
 //! Two packings share that contract:
-//! * [`Packed`]: the paper's (Fig. 3), several counters in the lanes of a word, one addition
+//! * `Packed`: the paper's (Fig. 3), several counters in the lanes of a word, one addition
 //!   each; reading a counter back is a shift and a mask;
-//! * [`BitSliced`]: bit `b` of 64 counters in one word, an update a ripple of word operations;
+//! * `BitSliced`: bit `b` of 64 counters in one word, an update a ripple of word operations;
 //!   the zero counters (the visible samples) come out as one mask.
 //!
 //! The technique takes the bit-sliced form when it needs only which samples are visible and the

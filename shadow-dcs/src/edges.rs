@@ -69,6 +69,25 @@ pub(crate) fn orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
 }
 
 impl SceneEdge {
+    /// A boundary edge `a b` of one two-sided face with third vertex `third` (always a
+    /// silhouette): what tests build edges from.
+    #[cfg(test)]
+    pub fn boundary(a: DVec3, b: DVec3, third: DVec3) -> Self {
+        let normal = (b - a).cross(third - a);
+        Self {
+            a,
+            b,
+            faces: vec![EdgeFace {
+                third,
+                normal,
+                offset: -normal.dot(a),
+                weight: 1,
+                two_sided: true,
+            }],
+            always: true,
+        }
+    }
+
     /// `k_e`: the change of a depth complexity when a segment from the fixed end `x` sweeps
     /// across the edge, its other end leaving the side of plane `(x, a, b)` where `from` lies.
     /// Each counted face adds its weight when the sweep moves onto the face's side and subtracts

@@ -8,9 +8,13 @@
 //!
 //! * [`edges`]: scene edges, weights and accurate or standard silhouette detection (section 4.1);
 //! * [`constant`]: the integration constant by the shadow-volume step (section 4.1);
-//! * [`wedges`]: the view samples inside each penumbra wedge (section 4.2);
-//! * [`coverage`]: the light samples an edge covers, exactly (Algorithm 1, Fig. 2), and the
-//!   exact test that an edge seen from a pixel covers part of a planar light at all;
+//! * [`wedges`]: each penumbra wedge's bounding planes and weight (section 4.2);
+//! * `bins` (internal): the box hierarchy over the view samples that finds each wedge's view
+//!   samples (blocks, squares, tiles, then the tile's view samples);
+//! * [`coverage`]: the light samples an edge covers, exactly (Algorithm 1, Fig. 2), in 3D, and
+//!   the exact test that an edge seen from a pixel covers part of a planar light at all;
+//! * `planar` (internal): the same test in a planar light's plane, set up per pair from per-edge
+//!   vectors in single precision;
 //! * `angular` (internal): a per-pixel angular index of the light samples that finds each
 //!   edge's candidate samples with two lookups (section 7.3's sector table, per pixel);
 //! * `centred` (internal): the per-(pixel, edge) tests in light-centred single precision, with
@@ -18,7 +22,8 @@
 //! * `lanes` (internal): tiles of 4 x 4 view samples in structure-of-arrays form, on which the
 //!   wedge scan tests a wedge's planes and weights for the whole tile at once;
 //! * [`discrete`]: the sector and line tables of section 7.3 (Fig. 8);
-//! * [`counters`]: packed counters with overflow detection (sections 4.3, 4.4, 5.3);
+//! * [`counters`]: packed counters with overflow detection (sections 4.3, 4.4, 5.3), the
+//!   paper's lanes and a bit-sliced form;
 //! * [`technique`]: the [`Dcs`] technique; [`presets`] registers its configurations.
 //!
 //! # When DCS pays

@@ -247,24 +247,10 @@ mod tests {
     use super::*;
     use crate::centred::CentredEdge;
     use crate::coverage::EdgeTest;
-    use crate::edges::EdgeFace;
     use shadow_core::sampling::{hash_words, unit_float};
 
     fn edge(a: DVec3, b: DVec3) -> SceneEdge {
-        let third = (a + b) * 0.5 + DVec3::new(0.0, 0.0, 0.1);
-        let normal = (b - a).cross(third - a);
-        SceneEdge {
-            a,
-            b,
-            faces: vec![EdgeFace {
-                third,
-                normal,
-                offset: -normal.dot(a),
-                weight: 1,
-                two_sided: true,
-            }],
-            always: true,
-        }
+        SceneEdge::boundary(a, b, (a + b) * 0.5 + DVec3::new(0.0, 0.0, 0.1))
     }
 
     /// The light-plane test covers the samples the 3D test covers, up to rounding at ties, far

@@ -5,22 +5,26 @@
 //!    [`crate::edges`], section 4.1);
 //! 2. the integration constant `D(p, c)` of every view sample by the shadow-volume step
 //!    ([`crate::constant`], section 4.1), and the counter width from its maximum (section 5.3);
-//! 3. the wedges' view samples and each one's weight ([`crate::wedges`], section 4.2);
+//! 3. square by square (16 x 16 pixels), the wedges' view samples and each one's weight
+//!    ([`crate::wedges`] and the box hierarchy of `bins`, section 4.2), with each pair's
+//!    light-plane test set up on the way (planar lights, `planar`);
 //! 4. per view sample: its light samples (the shared [`LightSampler`], section 5), the samples
-//!    each wedge edge covers ([`crate::coverage`]; exact or the discrete tables of section 7.3),
-//!    the packed counters updated outer wedges first ([`crate::counters`], sections 4.3-4.4),
+//!    each wedge edge covers (the light-plane test or [`crate::coverage`]'s 3D one, exact; or
+//!    the discrete tables of section 7.3), the packed counters updated outer wedges first
+//!    ([`crate::counters`], sections 4.3-4.4),
 //!    then the visibility coefficient (eq. 1), its RGB form for textured lights (eq. 2), the
 //!    saturating opacity sum for semi-opaque occluders (section 3) and, on request, the direct
 //!    illumination from the per-sample binary visibility (eq. 6).
 //!
 //! Work a view sample does not need is skipped and counted: a receiver facing away from the
-//! whole light is 0 without samples; one in no wedge, or whose wedge edges all miss the light
-//! (the exact light-overlap test, `wedge-pairs-off-light`), takes its integration constant for
-//! every sample (fully lit or umbra, no counters); a pair whose angular sector holds no sample
+//! whole light is 0 without samples; one in no wedge, or (3D test) whose wedge edges all miss
+//! the light (the exact light-overlap test, `wedge-pairs-off-light`), takes its integration
+//! constant for every sample (fully lit or umbra, no counters); a pair whose angular sector holds no sample
 //! is dropped without a per-sample test (`wedge-pairs-empty-sector`); with the refined tables
 //! of section 7.3, a pair with many candidates looks its line up in the line table, which
 //! settles every candidate it can (`refined-line-cells`); the texture and opacity paths run only
-//! when the light is textured or the scene semi-opaque.
+//! when the light is textured or the scene semi-opaque, and a pixel whose caller reads only
+//! which samples are visible gets that mask and no per-sample values.
 //!
 //! Light samples behind the receiver's tangent plane are occluded, and view samples are offset
 //! off their surface, exactly as the reference does ([`shadow_core::offset`]), so that with the
@@ -205,10 +209,10 @@ struct Scratch {
     vis: Vec<f32>,
 }
 
-/// Per-thread buffers of a strip: its pairs, the scan's buffers, and the pixels' scratch (kept
-/// from strip to strip, so that they are allocated once per thread).
+/// Per-thread buffers of a square: its pairs, the scan's buffers, and the pixels' scratch (kept
+/// from square to square, so that they are allocated once per thread).
 #[derive(Default)]
-struct StripBuffers {
+struct SquareBuffers {
     pairs: SquarePairs,
     scan: SquareScratch,
     scratch: Scratch,
@@ -393,25 +397,29 @@ impl Dcs {
         })
     }
 
-    /// Runs the per-pixel pass over the strip `rect`: its wedge pairs (from its block's wedges
-    /// `block`), then every view sample, handed to `visit` with its class and the scratch holding
-    /// its samples and visibilities.
-    fn run_strip(
+    /// Runs the per-pixel pass over the square `rect`: its wedge pairs (from the wedges its box
+    /// keeps, `wedges`), then every view sample, handed to `visit` with its class and the
+    /// scratch holding its visible samples and, with `values`, its samples' visibilities and
+    /// depth complexities.
+    #[allow(clippy::too_many_arguments)]
+    fn run_square(
         &self,
         p: &Prepared,
         f: &Frame,
         wedges: &[u32],
         rect: Rect,
+        values: bool,
         counts: &mut Counts,
-        buffers: &mut StripBuffers,
+        buffers: &mut SquareBuffers,
         mut visit: impl FnMut(usize, &ViewSample, PixelClass, &Scratch),
     ) {
         let view = f.view;
-        let StripBuffers {
+        let SquareBuffers {
             pairs,
             scan,
             scratch,
         } = buffers;
+        scratch.want_values = values;
         square_pairs(&Self::scan_input(p, f), wedges, rect, pairs, scan);
         counts.scanned += pairs.scanned;
         counts.ties += pairs.ties;
@@ -447,11 +455,11 @@ impl Dcs {
     /// Runs `work` on every square of the view in parallel, with the wedges its box keeps (the
     /// box hierarchy of [`crate::bins`]: blocks, then their squares). Returns each square's
     /// result and the number of (block, wedge) pairs kept.
-    fn strips<T: Send>(
+    fn squares<T: Send>(
         &self,
         p: &Prepared,
         f: &Frame,
-        work: impl Fn(Rect, &[u32], &mut StripBuffers) -> T + Sync + Send,
+        work: impl Fn(Rect, &[u32], &mut SquareBuffers) -> T + Sync + Send,
     ) -> (Vec<(Rect, T)>, u64) {
         let view = f.view;
         let input = Self::scan_input(p, f);
@@ -465,7 +473,7 @@ impl Dcs {
                 let out = squares
                     .par_iter()
                     .zip(&lists)
-                    .map_init(StripBuffers::default, |buffers, (&r, list)| {
+                    .map_init(SquareBuffers::default, |buffers, (&r, list)| {
                         (r, work(r, list, buffers))
                     })
                     .collect();
@@ -987,18 +995,18 @@ impl Dcs {
         let p = self.prepared()?;
         let mut stats = Stats::default();
         let f = self.frame(p, view, &mut stats)?;
-        let (parts, _) = self.strips(p, &f, |rect, block, buffers| {
+        let (parts, _) = self.squares(p, &f, |rect, block, buffers| {
             let mut out = Vec::with_capacity(rect.len());
             let mut counts = Counts::default();
             let mut units = Vec::new();
             let mut samples = Vec::new();
             // Eq. 6 weighs every sample by its visibility.
-            buffers.scratch.want_values = true;
-            self.run_strip(
+            self.run_square(
                 p,
                 &f,
                 block,
                 rect,
+                true,
                 &mut counts,
                 buffers,
                 |i, s, _, scratch| {
@@ -1181,7 +1189,7 @@ impl ShadowTechnique for Dcs {
         }
         let output = self.output;
         let (strips, block_wedges) = stats.time("depth-complexity", || {
-            self.strips(p, &f, |rect, block, buffers| {
+            self.squares(p, &f, |rect, block, buffers| {
                 let m = rect.len();
                 let rw = rect.width() as usize;
                 let mut r = Row {
@@ -1207,13 +1215,13 @@ impl ShadowTechnique for Dcs {
                     counts: Counts::default(),
                 };
                 let mut counts = Counts::default();
-                buffers.scratch.want_values =
-                    textured || output == PerSampleOutput::Counters || p.units != 1;
-                self.run_strip(
+                let values = textured || output == PerSampleOutput::Counters || p.units != 1;
+                self.run_square(
                     p,
                     &f,
                     block,
                     rect,
+                    values,
                     &mut counts,
                     buffers,
                     |i, _, class, scratch| {

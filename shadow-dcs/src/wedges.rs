@@ -248,7 +248,6 @@ pub(crate) fn convex_hull(mut p: Vec<DVec2>) -> Vec<DVec2> {
 mod tests {
     use super::*;
     use crate::coverage::EdgeTest;
-    use crate::edges::EdgeFace;
     use glam::Vec3;
     use shadow_core::light::{
         AreaLight, DiskLight, PolygonLight, Radiance, RectLight, SphereLight,
@@ -297,19 +296,7 @@ mod tests {
             let dir = Vec3::new(r(10), r(11) * 0.5, r(12)) * 0.4;
             let (a, b) = ((mid - dir).as_dvec3(), (mid + dir).as_dvec3());
             let third = (mid + Vec3::new(r(13), r(14), r(15)) * 0.3).as_dvec3();
-            let normal = (b - a).cross(third - a);
-            let e = SceneEdge {
-                a,
-                b,
-                faces: vec![EdgeFace {
-                    third,
-                    normal,
-                    offset: -normal.dot(a),
-                    weight: 1,
-                    two_sided: true,
-                }],
-                always: true,
-            };
+            let e = SceneEdge::boundary(a, b, third);
             let planes = wedge_planes(&e, &shape);
             let cd = shape.center.as_dvec3();
             for j in 0..40u64 {

@@ -51,19 +51,6 @@ fn spread(m: u64, bits: u32) -> u64 {
 
 impl Counters for Packed {
     fn reset(&mut self, bits: u32, n: usize, init: u64) -> Result<(), OutOfRange> {
-        self.reset(bits, n, init)
-    }
-    fn add(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
-        self.add(mask, k)
-    }
-    fn sub(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
-        self.sub(mask, k)
-    }
-}
-
-impl Packed {
-    /// Resets to `n` counters of `bits` bits, all holding `init`.
-    pub fn reset(&mut self, bits: u32, n: usize, init: u64) -> Result<(), OutOfRange> {
         if init > super::lane_max(bits) {
             return Err(OutOfRange);
         }
@@ -75,16 +62,7 @@ impl Packed {
         Ok(())
     }
 
-    /// Lane mask of word `w` taken from the sample bit mask.
-    #[inline]
-    fn lane_bits(&self, mask: &[u64], w: usize) -> u64 {
-        let lanes = 64 / self.bits as usize;
-        let first = w * lanes;
-        (mask[first / 64] >> (first % 64)) & ((1u64 << lanes) - 1)
-    }
-
-    /// Adds `k` to every counter whose bit is set in `mask`.
-    pub fn add(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
+    fn add(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
         self.update(mask, k, |x, y, high, low| {
             let s = ((x & low) + (y & low)) ^ ((x ^ y) & high);
             // Carry out of each lane's top bit.
@@ -92,13 +70,22 @@ impl Packed {
         })
     }
 
-    /// Subtracts `k` from every counter whose bit is set in `mask`.
-    pub fn sub(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
+    fn sub(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
         self.update(mask, k, |x, y, high, low| {
             let d = ((x | high) - (y & low)) ^ ((x ^ !y) & high);
             // Borrow out of each lane's top bit.
             (d, ((!x & y) | (!(x ^ y) & d)) & high)
         })
+    }
+}
+
+impl Packed {
+    /// Lane mask of word `w` taken from the sample bit mask.
+    #[inline]
+    fn lane_bits(&self, mask: &[u64], w: usize) -> u64 {
+        let lanes = 64 / self.bits as usize;
+        let first = w * lanes;
+        (mask[first / 64] >> (first % 64)) & ((1u64 << lanes) - 1)
     }
 
     /// Applies a lane-wise operation `op(x, y, high, low) -> (result, out-of-range lanes)` with

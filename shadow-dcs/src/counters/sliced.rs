@@ -42,25 +42,6 @@ fn valid(n: usize, w: usize) -> u64 {
 
 impl Counters for BitSliced {
     fn reset(&mut self, bits: u32, n: usize, init: u64) -> Result<(), OutOfRange> {
-        self.reset(bits, n, init)
-    }
-    fn add(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
-        self.add(mask, k)
-    }
-    fn sub(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
-        self.sub(mask, k)
-    }
-    fn add_one(&mut self, mask: u64, k: u64) -> Result<(), OutOfRange> {
-        self.add_one(mask, k)
-    }
-    fn sub_one(&mut self, mask: u64, k: u64) -> Result<(), OutOfRange> {
-        self.sub_one(mask, k)
-    }
-}
-
-impl BitSliced {
-    /// Resets to `n` counters of `bits` bits, all holding `init`.
-    pub fn reset(&mut self, bits: u32, n: usize, init: u64) -> Result<(), OutOfRange> {
         if init > super::lane_max(bits) {
             return Err(OutOfRange);
         }
@@ -75,28 +56,26 @@ impl BitSliced {
         Ok(())
     }
 
-    /// Adds `k` to every counter whose bit is set in `mask`.
-    pub fn add(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
+    fn add(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
         self.update(mask, k, add_step)
     }
 
-    /// Subtracts `k` from every counter whose bit is set in `mask`.
-    pub fn sub(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
+    fn sub(&mut self, mask: &[u64], k: u64) -> Result<(), OutOfRange> {
         self.update(mask, k, sub_step)
     }
 
-    /// [`Packed::add`] for counters that fit one word of samples (`n <= 64`).
     #[inline]
-    pub fn add_one(&mut self, mask: u64, k: u64) -> Result<(), OutOfRange> {
+    fn add_one(&mut self, mask: u64, k: u64) -> Result<(), OutOfRange> {
         self.update_word(0, mask, k, add_step)
     }
 
-    /// [`Packed::sub`] for counters that fit one word of samples (`n <= 64`).
     #[inline]
-    pub fn sub_one(&mut self, mask: u64, k: u64) -> Result<(), OutOfRange> {
+    fn sub_one(&mut self, mask: u64, k: u64) -> Result<(), OutOfRange> {
         self.update_word(0, mask, k, sub_step)
     }
+}
 
+impl BitSliced {
     /// Adds or subtracts `k` times the samples of `mask`, word by word.
     #[inline]
     fn update(
@@ -216,38 +195,6 @@ impl BitSliced {
 mod tests {
     use super::*;
     use crate::counters::WIDTHS;
-
-    #[test]
-    fn bit_sliced_updates_match_plain_counters() {
-        for bits in WIDTHS {
-            for n in [5usize, 64, 100] {
-                let mut p = BitSliced::default();
-                p.reset(bits, n, 3).unwrap();
-                let mut plain = vec![3u64; n];
-                if bits == 8 {
-                    continue;
-                }
-                let mut state = 12345u64;
-                for step in 0..50 {
-                    state = shadow_core::sampling::mix64(state);
-                    let mask = [state, shadow_core::sampling::mix64(state ^ 7)];
-                    let k = [1, 2, 3, 255, 7][step % 5];
-                    p.add(&mask, k).unwrap();
-                    for i in 0..n {
-                        if mask[i / 64] >> (i % 64) & 1 == 1 {
-                            plain[i] += k;
-                        }
-                    }
-                }
-                for i in 0..n {
-                    assert_eq!(p.get(i), plain[i], "bits {bits} counter {i}");
-                }
-                let mut all = Vec::new();
-                p.unpack_into(&mut all);
-                assert_eq!(all, plain, "bits {bits}: unpacked");
-            }
-        }
-    }
 
     #[test]
     fn zero_masks_match_the_counters() {
