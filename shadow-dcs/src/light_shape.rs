@@ -182,6 +182,14 @@ impl LightShape {
         })
     }
 
+    /// The centre and radius of a sphere light.
+    pub fn sphere(&self) -> Option<(DVec3, f64)> {
+        match self.exact {
+            Exact::Sphere { center, radius } => Some((center, radius)),
+            _ => None,
+        }
+    }
+
     /// Minimum and maximum of `n . q + d` over the light's points `q` (exact).
     pub fn range(&self, n: DVec3, d: f64) -> (f64, f64) {
         match &self.exact {

@@ -10,8 +10,8 @@
 //! * for a planar light, the planes through an end point `v` and a side of the light's polygon
 //!   (the faces of the anti-cone `K_v`) that have the other end point on the anti-cone's side:
 //!   every `K_x` for `x` on the edge then lies on that side too, since `x` does;
-//! * for a sphere light, a side plane at each end point found by tilting the edge direction
-//!   away from the light.
+//! * for a sphere light, the two planes through the edge's line tangent to the sphere, and
+//!   planes through each end point tangent to the sphere with the other end in front.
 //!
 //! A view sample outside any of these planes sees no part of the light through the edge. The
 //! view samples inside each wedge are found by the box hierarchy of `bins` (the spatial
@@ -58,7 +58,8 @@ const END_PLANES: usize = 4;
 
 /// Half-spaces that hold the wedge of edge `e` for `light` (see the module documentation):
 /// the supporting planes through the edge's line, and the anti-cone faces at each end point
-/// (planar lights) or one tilted side plane per end point (sphere lights). Each is moved outward
+/// (planar lights: through a side of the light's polygon; sphere lights: tangent to the sphere).
+/// Other shapes get one tilted side plane per end point. Each is moved outward
 /// by `1e-6` of the edge's scale, so that rounding never rejects a view sample the wedge holds.
 pub(crate) fn wedge_planes(e: &SceneEdge, light: &LightShape) -> Vec<Plane> {
     let c = light.center.as_dvec3();
@@ -87,7 +88,20 @@ pub(crate) fn wedge_planes(e: &SceneEdge, light: &LightShape) -> Vec<Plane> {
                 (a.min(v), b.max(v))
             })
     };
-    for l in &hull {
+    if let Some((sc, sr)) = light.sphere() {
+        // The two planes through the edge's line tangent to the sphere, the sphere behind.
+        let d = ab.normalize();
+        let q = (sc - e.a) - d * d.dot(sc - e.a);
+        let ql = q.length();
+        if ql > sr * (1.0 + 1e-9) {
+            let (qh, perp) = (q / ql, d.cross(q / ql));
+            let (cos, sin) = (sr / ql, (1.0 - (sr / ql).powi(2)).sqrt());
+            for side in [-1.0, 1.0] {
+                planes.extend(plane(-qh * cos + perp * sin * side, e.a));
+            }
+        }
+    }
+    for l in hull.iter().filter(|_| light.sphere().is_none()) {
         let n = ab.cross(*l - e.a);
         if !(n.length() > eps * scale) {
             continue;
@@ -120,6 +134,32 @@ pub(crate) fn wedge_planes(e: &SceneEdge, light: &LightShape) -> Vec<Plane> {
                         (false, true) => n,
                         _ => continue,
                     };
+                    if n.dot(w - v) >= 0.0 {
+                        planes.extend(plane(n, v));
+                    }
+                }
+            }
+        }
+        None if light.sphere().is_some() => {
+            // Planes through each end point tangent to the sphere, the sphere behind and the
+            // other end in front: the faces of the end point's anti-cone that hold the edge.
+            let (sc, sr) = light.sphere().expect("a sphere light");
+            for (v, w) in [(e.a, e.b), (e.b, e.a)] {
+                let to_c = sc - v;
+                let dist = to_c.length();
+                if !(dist > sr * (1.0 + 1e-9)) {
+                    continue;
+                }
+                let u = to_c / dist;
+                let along = (w - v) - u * u.dot(w - v);
+                if !(along.length() > 0.0) {
+                    continue;
+                }
+                let e0 = along.normalize();
+                let e1 = u.cross(e0);
+                let (sin, cos) = (sr / dist, (1.0 - (sr / dist).powi(2)).sqrt());
+                for t in [e0, (e0 + e1).normalize(), (e0 - e1).normalize()] {
+                    let n = -u * sin + t * cos;
                     if n.dot(w - v) >= 0.0 {
                         planes.extend(plane(n, v));
                     }
