@@ -927,28 +927,40 @@ impl Dcs {
         scratch.mask.resize(words, 0);
         scratch.batch_candidates.resize(words, 0);
         counts.edge_tests += tests.len() as u64;
-        if let (true, [above]) = (indexed, &scratch.above[..]) {
+        if let (true, &[above]) = (indexed, &scratch.above[..]) {
             // One word of samples: candidates and covered samples as plain words.
             let samples = &scratch.planar_samples;
             let (xs, ys) = (samples.first_word_x(), samples.first_word_y());
-            for (pairs, quad) in entries.chunks(4).zip(tests.chunks(4)) {
-                let mut four = [PlanarTest::NONE; 4];
-                four[..quad.len()].copy_from_slice(quad);
-                let r = QuadRanges::of_tests(&four);
-                for (j, (pair, test)) in pairs.iter().zip(quad).enumerate() {
-                    let cand = scratch.angular.quad_word(&r, j) & above;
+            let index = &scratch.angular;
+            let (masks, weights) = (&mut scratch.masks, &mut scratch.weights);
+            let (mut empty, mut covered) = (0, 0);
+            let mut quad_of = |pairs: &[Pair], four: &[PlanarTest; 4]| {
+                let r = QuadRanges::of_tests(four);
+                for (j, (pair, test)) in pairs.iter().zip(four).enumerate() {
+                    let cand = index.quad_word(&r, j) & above;
                     if cand == 0 {
-                        counts.sector_empty += 1;
+                        empty += 1;
                         continue;
                     }
                     let hit = test.covered_of(xs, ys, cand);
                     if hit != 0 {
-                        counts.covered_updates += 1;
-                        scratch.masks.push(hit);
-                        scratch.weights.push(i64::from(pair.k));
+                        covered += 1;
+                        masks.push(hit);
+                        weights.push(i64::from(pair.k));
                     }
                 }
+            };
+            let (whole, rest) = tests.as_chunks::<4>();
+            for (pairs, four) in entries.chunks_exact(4).zip(whole) {
+                quad_of(pairs, four);
             }
+            if !rest.is_empty() {
+                let mut four = [PlanarTest::NONE; 4];
+                four[..rest.len()].copy_from_slice(rest);
+                quad_of(&entries[entries.len() - rest.len()..], &four);
+            }
+            counts.sector_empty += empty;
+            counts.covered_updates += covered;
             return;
         }
         for (pairs, quad) in entries.chunks(4).zip(tests.chunks(4)) {
