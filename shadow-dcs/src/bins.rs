@@ -350,6 +350,13 @@ pub(crate) struct SquarePairs {
     /// With the light-plane test, each pair's test (same order as `entries`; a placeholder
     /// that covers nothing for a pixel that takes the 3D test).
     tests: Vec<PlanarTest>,
+    /// What the scan did.
+    pub counts: ScanCounts,
+}
+
+/// Work counters of the wedge scan.
+#[derive(Debug, Default, Clone, Copy)]
+pub(crate) struct ScanCounts {
     /// Pairs dropped on the tie of the light-plane test's orientation.
     pub ties: u64,
     /// View samples whose weight took the exact form.
@@ -358,8 +365,19 @@ pub(crate) struct SquarePairs {
     pub scanned: u64,
     /// (tile, wedge) candidates evaluated on the tile's view samples.
     pub tile_wedges: u64,
-    /// Wedges kept by the square's box.
+    /// Wedges kept by the squares' boxes.
     pub square_wedges: u64,
+}
+
+impl ScanCounts {
+    /// Adds `o`'s counts.
+    pub fn add(&mut self, o: &ScanCounts) {
+        self.ties += o.ties;
+        self.exact_weights += o.exact_weights;
+        self.scanned += o.scanned;
+        self.tile_wedges += o.tile_wedges;
+        self.square_wedges += o.square_wedges;
+    }
 }
 
 impl SquarePairs {
@@ -392,17 +410,133 @@ impl SquarePairs {
     }
 }
 
+/// A square's tiles, their view samples and each tile's wedges (the hierarchy's third level).
+#[derive(Default)]
+pub(crate) struct SquareTiles {
+    rect: Option<Rect>,
+    boxes: Boxes,
+    /// Tiles per row of tiles.
+    pub across: usize,
+    /// Each tile's view samples.
+    pub lanes: Vec<TileLanes>,
+    /// Each tile's wedges (silhouette indices in order).
+    pub lists: Vec<Vec<u32>>,
+}
+
+impl SquareTiles {
+    /// The tiles of square `rect` and the wedges of `wedges` each tile's box keeps.
+    pub fn set(&mut self, input: &ScanInput, wedges: &[u32], rect: Rect, counts: &mut ScanCounts) {
+        self.rect = Some(rect);
+        self.across = rect_lanes(
+            input.width,
+            rect.cols,
+            rect.rows,
+            input.centred,
+            input.active,
+            &mut self.lanes,
+        );
+        self.boxes.set(self.lanes.iter().map(TileLanes::bounds));
+        self.lists.resize(self.lanes.len(), Vec::new());
+        for l in self.lists.iter_mut() {
+            l.clear();
+        }
+        counts.square_wedges += wedges.len() as u64;
+        for &wi in wedges {
+            let mask = self.boxes.test(&input.wedges[wi as usize], input.slack);
+            counts.tile_wedges += u64::from(mask.count_ones());
+            for t in bits_of(mask) {
+                self.lists[t].push(wi);
+            }
+        }
+    }
+
+    /// The image column and row of tile `t`'s first view sample.
+    pub fn origin(&self, t: usize) -> (u32, u32) {
+        let r = self.rect.expect("tiles of a square");
+        (
+            r.cols.0 + (t % self.across) as u32 * TILE_W,
+            r.rows.0 + (t / self.across) as u32 * TILE_H,
+        )
+    }
+}
+
+/// The pairs of wedge `wi` with the view samples of a tile (`tile`, `quads`, its first view
+/// sample at column and row `origin`): the weight first (it rejects more view samples than the
+/// planes), exact where the single-precision signs are uncertain, then the bounding planes on
+/// the view samples left. Calls `pair(lane, image index, k)` for each view sample with a
+/// non-zero weight, in lane order.
+#[inline]
+pub(crate) fn tile_pairs(
+    input: &ScanInput,
+    wi: u32,
+    tile: &TileLanes,
+    quads: &TileQuads,
+    origin: (u32, u32),
+    counts: &mut ScanCounts,
+    mut pair: impl FnMut(usize, usize, i32),
+) {
+    let wedge = &input.wedges[wi as usize];
+    counts.scanned += u64::from(tile.active.count_ones());
+    let fast = wedge.weight.as_ref().and_then(|f| f.weight_lanes(quads));
+    let candidates = match &fast {
+        Some(f) => tile.active & (f.nonzero | !f.certain),
+        None => tile.active,
+    };
+    let inside = wedge.inside(quads, candidates);
+    let w = input.width as usize;
+    for j in lanes_of(inside) {
+        let i =
+            (origin.1 + j as u32 / TILE_W) as usize * w + (origin.0 + j as u32 % TILE_W) as usize;
+        let k = match &fast {
+            Some(f) if f.certain >> j & 1 == 1 => f.k(j),
+            _ => {
+                counts.exact_weights += 1;
+                let e = &input.edges[wedge.edge as usize];
+                match e.sweep_weight(input.origins[i].as_dvec3(), input.c, false) {
+                    Some(k) => k,
+                    None => continue,
+                }
+            }
+        };
+        if k != 0 {
+            pair(j, i, k.clamp(i32::MIN as i64, i32::MAX as i64) as i32);
+        }
+    }
+}
+
+/// The light-plane test of wedge `wi` from view sample `i` (`l1` at least the length of its
+/// light-centred position): `Some(None)` when the view sample takes the 3D test, `None` on the
+/// tie of the orientation.
+#[inline]
+pub(crate) fn planar_test(
+    input: &ScanInput,
+    wi: u32,
+    i: usize,
+    l1: f32,
+) -> Option<Option<PlanarTest>> {
+    let Some((centred_edges, pixels)) = input.planar else {
+        return Some(None);
+    };
+    match (&input.wedges[wi as usize].planar, pixels[i]) {
+        (Some(pe), true) => {
+            let exact = || {
+                let pc = input.origins[i].as_dvec3() - input.c;
+                centred_edges[wi as usize].orientation(pc)
+            };
+            pe.test(input.centred[i], l1, exact).map(Some)
+        }
+        _ => Some(None),
+    }
+}
+
 /// Per-thread buffers of the square scan.
 #[derive(Default)]
 pub(crate) struct SquareScratch {
-    tiles: Boxes,
-    /// Each tile's wedges.
-    lists: Vec<Vec<u32>>,
+    tiles: SquareTiles,
     /// A tile's pairs as found: lane, pair, test.
     found: Vec<(u8, Pair)>,
     found_tests: Vec<PlanarTest>,
     order: Vec<u32>,
-    lanes: Vec<TileLanes>,
 }
 
 /// What the wedge scan reads of a frame.
@@ -440,97 +574,44 @@ pub(crate) fn square_pairs(
     out.tests.clear();
     out.start.clear();
     out.start.push(0);
-    out.scanned = 0;
-    out.tile_wedges = 0;
-    out.square_wedges = wedges.len() as u64;
-    out.ties = 0;
-    out.exact_weights = 0;
+    out.counts = ScanCounts::default();
     let SquareScratch {
         tiles,
-        lists,
         found,
         found_tests,
         order,
-        lanes,
     } = scratch;
-    let across = rect_lanes(
-        input.width,
-        rect.cols,
-        rect.rows,
-        input.centred,
-        input.active,
-        lanes,
-    );
-    out.across = across;
-    tiles.set(lanes.iter().map(TileLanes::bounds));
-    lists.resize(lanes.len(), Vec::new());
-    for l in lists.iter_mut() {
-        l.clear();
-    }
-    for &wi in wedges {
-        let mask = tiles.test(&input.wedges[wi as usize], input.slack);
-        out.tile_wedges += u64::from(mask.count_ones());
-        for t in bits_of(mask) {
-            lists[t].push(wi);
-        }
-    }
-    let w = input.width as usize;
-    for (t, (tile, list)) in lanes.iter().zip(lists.iter()).enumerate() {
+    tiles.set(input, wedges, rect, &mut out.counts);
+    out.across = tiles.across;
+    for (t, (tile, list)) in tiles.lanes.iter().zip(tiles.lists.iter()).enumerate() {
         let quads = tile.quads();
-        let x0 = rect.cols.0 + (t % across) as u32 * TILE_W;
-        let y0 = rect.rows.0 + (t / across) as u32 * TILE_H;
+        let origin = tiles.origin(t);
         found.clear();
         found_tests.clear();
+        let mut ties = 0;
         for &wi in list {
-            let wedge = &input.wedges[wi as usize];
-            out.scanned += u64::from(tile.active.count_ones());
-            // The weight first (it rejects more view samples than the planes), then the planes
-            // on the view samples left.
-            let fast = wedge.weight.as_ref().and_then(|f| f.weight_lanes(&quads));
-            let candidates = match &fast {
-                Some(f) => tile.active & (f.nonzero | !f.certain),
-                None => tile.active,
-            };
-            let inside = wedge.inside(&quads, candidates);
-            for j in lanes_of(inside) {
-                let i = (y0 + j as u32 / TILE_W) as usize * w + (x0 + j as u32 % TILE_W) as usize;
-                let k = match &fast {
-                    Some(f) if f.certain >> j & 1 == 1 => f.k(j),
-                    _ => {
-                        out.exact_weights += 1;
-                        let e = &input.edges[wedge.edge as usize];
-                        match e.sweep_weight(input.origins[i].as_dvec3(), input.c, false) {
-                            Some(k) => k,
-                            None => continue,
-                        }
-                    }
-                };
-                if k == 0 {
-                    continue;
-                }
-                if let Some((centred_edges, pixels)) = input.planar {
-                    let test = match (&wedge.planar, pixels[i]) {
-                        (Some(pe), true) => {
-                            let exact = || {
-                                let pc = input.origins[i].as_dvec3() - input.c;
-                                centred_edges[wi as usize].orientation(pc)
-                            };
-                            match pe.test(input.centred[i], tile.l1[j], exact) {
-                                Some(t) => t,
-                                None => {
-                                    out.ties += 1;
-                                    continue;
-                                }
+            tile_pairs(
+                input,
+                wi,
+                tile,
+                &quads,
+                origin,
+                &mut out.counts,
+                |j, i, k| {
+                    if input.planar.is_some() {
+                        match planar_test(input, wi, i, tile.l1[j]) {
+                            Some(t) => found_tests.push(t.unwrap_or(PlanarTest::NONE)),
+                            None => {
+                                ties += 1;
+                                return;
                             }
                         }
-                        _ => PlanarTest::NONE,
-                    };
-                    found_tests.push(test);
-                }
-                let k = k.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
-                found.push((j as u8, Pair { edge: wi, k }));
-            }
+                    }
+                    found.push((j as u8, Pair { edge: wi, k }));
+                },
+            );
         }
+        out.counts.ties += ties;
         // The tile's pairs lane by lane, each lane's in wedge order.
         let mut count = [0u32; LANES];
         for (j, _) in found.iter() {

@@ -43,7 +43,7 @@ use shadow_core::visibility::{PerSampleVisibility, PixelClass};
 
 use crate::angular::{AngularIndex, BATCH, QuadRanges};
 use crate::bins::{
-    BlockWedges, Rect, ScanInput, ScanWedge, SquarePairs, SquareScratch, square_pairs,
+    BlockWedges, Rect, ScanCounts, ScanInput, ScanWedge, SquarePairs, SquareScratch, square_pairs,
 };
 use crate::centred::CentredEdge;
 use crate::constant::{eye_constant, integration_constants};
@@ -230,10 +230,7 @@ struct Counts {
     plain_fallback: u64,
     negative: u64,
     ties: u64,
-    scanned: u64,
-    exact_weights: u64,
-    tile_wedges: u64,
-    square_wedges: u64,
+    scan: ScanCounts,
     pairs: u64,
     off_light: u64,
     sector_empty: u64,
@@ -251,10 +248,7 @@ impl Counts {
         self.plain_fallback += o.plain_fallback;
         self.negative += o.negative;
         self.ties += o.ties;
-        self.scanned += o.scanned;
-        self.exact_weights += o.exact_weights;
-        self.tile_wedges += o.tile_wedges;
-        self.square_wedges += o.square_wedges;
+        self.scan.add(&o.scan);
         self.pairs += o.pairs;
         self.off_light += o.off_light;
         self.sector_empty += o.sector_empty;
@@ -421,11 +415,7 @@ impl Dcs {
         } = buffers;
         scratch.want_values = values;
         square_pairs(&Self::scan_input(p, f), wedges, rect, pairs, scan);
-        counts.scanned += pairs.scanned;
-        counts.ties += pairs.ties;
-        counts.exact_weights += pairs.exact_weights;
-        counts.tile_wedges += pairs.tile_wedges;
-        counts.square_wedges += pairs.square_wedges;
+        counts.scan.add(&pairs.counts);
         counts.pairs += pairs.len() as u64;
         let w = view.width() as usize;
         for (j, x, y) in pairs.pixels() {
@@ -1367,12 +1357,12 @@ impl ShadowTechnique for Dcs {
         stats.add("counter-escalations", counts.escalations);
         stats.add("plain-counter-fallbacks", counts.plain_fallback);
         stats.add("negative-depth-complexity", counts.negative);
-        stats.add("edge-ties", counts.ties);
-        stats.add("wedge-pixels-scanned", counts.scanned);
-        stats.add("wedge-exact-weights", counts.exact_weights);
+        stats.add("edge-ties", counts.ties + counts.scan.ties);
+        stats.add("wedge-pixels-scanned", counts.scan.scanned);
+        stats.add("wedge-exact-weights", counts.scan.exact_weights);
         stats.add("bin-block-wedges", block_wedges);
-        stats.add("bin-square-wedges", counts.square_wedges);
-        stats.add("bin-tile-wedges", counts.tile_wedges);
+        stats.add("bin-square-wedges", counts.scan.square_wedges);
+        stats.add("bin-tile-wedges", counts.scan.tile_wedges);
         stats.add("wedge-pairs", counts.pairs);
         stats.add("wedge-pairs-off-light", counts.off_light);
         stats.add("wedge-pairs-empty-sector", counts.sector_empty);
