@@ -162,6 +162,18 @@ enum Horizon {
     Mixed,
 }
 
+/// What a pixel's pass keeps from its start to its end.
+struct PixelStart {
+    /// The integration constant (0 where it came out negative).
+    d0: u64,
+    /// Whether its samples get the angular index.
+    indexed: bool,
+    /// Whether it takes the light-plane test.
+    planar: bool,
+    /// Whether its samples are set up (it needs per-sample work).
+    ready: bool,
+}
+
 /// What the batched covered-sample step needs of the refined tables of section 7.3 for one
 /// pixel.
 struct Refined<'a> {
@@ -499,9 +511,11 @@ impl Dcs {
         }
     }
 
-    /// Per-sample visibility of pixel `i` into `scratch.vis` (and depth complexities into
-    /// `scratch.depth`), and its light samples into `scratch.samples` when the light is
-    /// textured (their radiances weigh eq. 2). Returns the class.
+    /// Per-sample visibility of pixel `i` into `scratch.visible` (with `scratch.want_values`,
+    /// also `scratch.vis` and depth complexities into `scratch.depth`), and its light samples
+    /// into `scratch.samples` when the light is textured (their radiances weigh eq. 2), from its
+    /// wedge pairs `entries` (and, for the light-plane test, their `tests`). Returns the class.
+    #[allow(clippy::too_many_arguments)]
     fn pixel(
         &self,
         p: &Prepared,
@@ -513,42 +527,8 @@ impl Dcs {
         scratch: &mut Scratch,
         counts: &mut Counts,
     ) -> PixelClass {
-        let n = self.sampler.count() as usize;
-        let words = n.div_ceil(64);
-        let origin = f.origins[i];
-        let horizon = f.horizon[i];
-        scratch.vis.clear();
-        scratch.depth.clear();
-        scratch.samples.clear();
-        scratch.visible.clear();
-        scratch.visible.resize(words, 0);
-        let values = scratch.want_values;
-        if horizon == Horizon::Below {
-            counts.facing_away += 1;
-            if values {
-                scratch.vis.resize(n, 0.0);
-                scratch.depth.resize(n, u64::MAX);
-            }
-            return PixelClass::Skipped;
-        }
-        let mut d0 = f.constants[i];
-        if d0 < 0 {
-            counts.negative += 1;
-            d0 = 0;
-        }
-        let d0 = d0 as u64;
-        let units = p.units as f32;
-        let textured = p.light.is_textured();
-        // Each pair's covered-sample test. The light-overlap test decides whether the pixel
-        // needs per-sample work at all: its samples are set up at the first pair that may cover
-        // the light (at once when the horizon cuts the light). With the angular index the later
-        // pairs go straight to their candidates, which drop off-light pairs more cheaply.
-        let o = origin.as_dvec3();
-        let pc = o - p.shape.center.as_dvec3();
-        if let (Some(poly), false) = (&p.polygon, entries.is_empty()) {
-            scratch.polygon.set(poly, f.centred[i]);
-        }
         // The refined tables of section 7.3 settle what they can of the index's candidates.
+        let pc = f.origins[i].as_dvec3() - p.shape.center.as_dvec3();
         let refined = match (self.covered, &p.tables) {
             (CoveredSamples::Refined, Some(t)) => Some(Refined {
                 tables: t,
@@ -561,34 +541,34 @@ impl Dcs {
         let indexed = p.shape.plane.is_some()
             && (self.covered == CoveredSamples::Exact || refined.is_some())
             && entries.len() >= INDEX_MIN_PAIRS;
-        let all_above = horizon == Horizon::Above;
-        // The light-plane form of the test (planar lights, exact covered samples, a receiver
-        // clear of the light's plane).
-        let planar = f.planar_ok.get(i).copied().unwrap_or(false);
-        let mut ready = horizon == Horizon::Mixed;
-        if ready {
-            self.sample_setup(p, s, origin, indexed, all_above, planar, scratch);
+        let Some(mut start) = self.pixel_start(p, f, i, s, indexed, scratch, counts) else {
+            return PixelClass::Skipped;
+        };
+        if let (Some(poly), false) = (&p.polygon, entries.is_empty()) {
+            scratch.polygon.set(poly, f.centred[i]);
         }
-        if planar && !entries.is_empty() {
-            if !ready {
-                self.sample_setup(p, s, origin, indexed, all_above, true, scratch);
-                ready = true;
-            }
+        // Each pair's covered-sample test. The light-overlap test decides whether the pixel
+        // needs per-sample work at all: its samples are set up at the first pair that may cover
+        // the light (at once when the horizon cuts the light). With the angular index the later
+        // pairs go straight to their candidates, which drop off-light pairs more cheaply.
+        if start.planar && !entries.is_empty() {
+            self.ensure_ready(p, f, i, s, &mut start, scratch);
             Self::planar_pairs(entries, tests, indexed, scratch, counts);
         }
+        let planar = start.planar;
         for pair in entries.iter().filter(|_| !planar) {
             let Some(test) = p.centred_edges[pair.edge as usize].test(pc) else {
                 counts.ties += 1;
                 continue;
             };
-            if (!ready || !indexed) && p.polygon.is_some() && !test.may_cover(&scratch.polygon) {
+            if (!start.ready || !indexed)
+                && p.polygon.is_some()
+                && !test.may_cover(&scratch.polygon)
+            {
                 counts.off_light += 1;
                 continue;
             }
-            if !ready {
-                self.sample_setup(p, s, origin, indexed, all_above, false, scratch);
-                ready = true;
-            }
+            self.ensure_ready(p, f, i, s, &mut start, scratch);
             if indexed {
                 // Candidates a batch at a time (their sector arithmetic vectorises).
                 scratch.batch.push(test);
@@ -600,13 +580,117 @@ impl Dcs {
                     Self::indexed_updates(scratch, counts, refined.as_ref());
                 }
             } else {
-                self.covered_update(p, s, o, pair, &test, scratch, counts);
+                self.covered_update(
+                    p,
+                    s,
+                    pc + p.shape.center.as_dvec3(),
+                    pair,
+                    &test,
+                    scratch,
+                    counts,
+                );
             }
         }
         if !scratch.batch.is_empty() {
             Self::indexed_updates(scratch, counts, refined.as_ref());
         }
-        if !ready {
+        self.pixel_finish(p, f, s, &start, scratch, counts)
+    }
+
+    /// The start of pixel `i`'s pass: its scratch emptied, its class when it faces away from the
+    /// whole light (`None`, its values set), else its integration constant and whether it takes
+    /// the light-plane test, with its samples set up at once when the horizon cuts the light
+    /// (`indexed`: with the angular index).
+    #[allow(clippy::too_many_arguments)]
+    fn pixel_start(
+        &self,
+        p: &Prepared,
+        f: &Frame,
+        i: usize,
+        s: &ViewSample,
+        indexed: bool,
+        scratch: &mut Scratch,
+        counts: &mut Counts,
+    ) -> Option<PixelStart> {
+        let n = self.sampler.count() as usize;
+        let horizon = f.horizon[i];
+        scratch.vis.clear();
+        scratch.depth.clear();
+        scratch.samples.clear();
+        scratch.visible.clear();
+        scratch.visible.resize(n.div_ceil(64), 0);
+        scratch.masks.clear();
+        scratch.weights.clear();
+        if horizon == Horizon::Below {
+            counts.facing_away += 1;
+            if scratch.want_values {
+                scratch.vis.resize(n, 0.0);
+                scratch.depth.resize(n, u64::MAX);
+            }
+            return None;
+        }
+        let mut d0 = f.constants[i];
+        if d0 < 0 {
+            counts.negative += 1;
+            d0 = 0;
+        }
+        let mut start = PixelStart {
+            d0: d0 as u64,
+            indexed,
+            // The light-plane form of the test (planar lights, exact covered samples, a
+            // receiver clear of the light's plane).
+            planar: f.planar_ok.get(i).copied().unwrap_or(false),
+            ready: false,
+        };
+        if horizon == Horizon::Mixed {
+            self.ensure_ready(p, f, i, s, &mut start, scratch);
+        }
+        Some(start)
+    }
+
+    /// Sets the pixel's samples up unless they are.
+    fn ensure_ready(
+        &self,
+        p: &Prepared,
+        f: &Frame,
+        i: usize,
+        s: &ViewSample,
+        start: &mut PixelStart,
+        scratch: &mut Scratch,
+    ) {
+        if !start.ready {
+            let all_above = f.horizon[i] == Horizon::Above;
+            self.sample_setup(
+                p,
+                s,
+                f.origins[i],
+                start.indexed,
+                all_above,
+                start.planar,
+                scratch,
+            );
+            start.ready = true;
+        }
+    }
+
+    /// The end of a pixel's pass: its integration constant for every sample when it set no
+    /// sample up, else its counters from the updates in `scratch`; returns its class.
+    fn pixel_finish(
+        &self,
+        p: &Prepared,
+        f: &Frame,
+        s: &ViewSample,
+        start: &PixelStart,
+        scratch: &mut Scratch,
+        counts: &mut Counts,
+    ) -> PixelClass {
+        let n = self.sampler.count() as usize;
+        let words = n.div_ceil(64);
+        let d0 = start.d0;
+        let units = p.units as f32;
+        let textured = p.light.is_textured();
+        let values = scratch.want_values;
+        if !start.ready {
             // No wedge: every sample has the integration constant.
             counts.constant_only += 1;
             let v = 1.0 - (d0 as f32 / units).min(1.0);
