@@ -93,6 +93,27 @@ impl ScanWedge {
         }
     }
 
+    /// The view samples where the edge may be a silhouette (its two face planes not surely of
+    /// different signs, `slack` the fold test's slack; every view sample without fold planes).
+    #[inline]
+    fn fold_lanes(&self, t: &TileQuads, slack: f32) -> LaneMask {
+        let [f1, f2] = &self.fold;
+        let s = Vec4::splat(slack);
+        let eval = |p: &BoxPlane, q: usize| {
+            Vec4::splat(p[0]) * t.x[q]
+                + Vec4::splat(p[1]) * t.y[q]
+                + Vec4::splat(p[2]) * t.z[q]
+                + Vec4::splat(p[3])
+        };
+        let mut m = 0;
+        for q in 0..QUADS {
+            let (v1, v2) = (eval(f1, q), eval(f2, q));
+            let differ = (v1.cmple(-s) | v2.cmple(-s)) & (v1.cmpge(s) | v2.cmpge(s));
+            m |= ((!differ.bitmask() & 0xf) as LaneMask) << (4 * q);
+        }
+        m
+    }
+
     /// The view samples of `lanes` that no bounding plane puts on its negative side (a NaN
     /// value rejects nothing); stops when no view sample is left.
     #[inline]
@@ -477,6 +498,12 @@ pub(crate) fn tile_pairs(
 ) {
     let wedge = &input.wedges[wi as usize];
     counts.scanned += u64::from(tile.active.count_ones());
+    // Where the edge cannot be a silhouette of the view sample (its face planes surely differ
+    // in sign there), the weight is zero: most tiles a wedge's box test keeps have no such
+    // view sample left.
+    if wedge.fold_lanes(quads, input.slack) & tile.active == 0 {
+        return;
+    }
     let fast = wedge.weight.as_ref().and_then(|f| f.weight_lanes(quads));
     let candidates = match &fast {
         Some(f) => tile.active & (f.nonzero | !f.certain),
