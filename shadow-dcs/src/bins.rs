@@ -49,11 +49,14 @@ const BOX_PAD: f32 = 1e-6;
 /// Boxes per [`Boxes`] (one bit each in a test's mask).
 pub(crate) const BOXES: usize = 64;
 
-/// A plane for box tests: `n.x`, `n.y`, `n.z`, `d`, `|n.x|`, `|n.y|`, `|n.z|`.
-type BoxPlane = [f32; 7];
+/// A plane for box tests: `n.x`, `n.y`, `n.z`, `d`; the tests take the absolute values of `n`
+/// themselves. Four floats rather than seven keep a wedge's box-test data (its planes, fold
+/// planes and count, at the front of [`ScanWedge`]) within 200 bytes instead of 344: a box
+/// test waits mostly on its first loads of the wedge (`perf`).
+type BoxPlane = Vec4;
 
 /// The plane every box passes (`0 . x + 1 >= 0`): unused plane slots.
-const OPEN: BoxPlane = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
+const OPEN: BoxPlane = Vec4::new(0.0, 0.0, 0.0, 1.0);
 
 /// Everything the wedge scan reads of one wedge, in one place (the scan visits wedges in
 /// silhouette order, square by square): its bounding planes and the planes of its edge's two
@@ -62,13 +65,13 @@ const OPEN: BoxPlane = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct ScanWedge {
     planes: [BoxPlane; BOX_PLANES],
-    /// Bounding planes in use (the rest are open).
-    used: usize,
     fold: [BoxPlane; 2],
-    weight: Option<FastWeight>,
-    planar: Option<PlanarEdge>,
+    /// Bounding planes in use (the rest are open).
+    used: u32,
     /// The scene edge.
     edge: u32,
+    weight: Option<FastWeight>,
+    planar: Option<PlanarEdge>,
 }
 
 impl ScanWedge {
@@ -76,7 +79,7 @@ impl ScanWedge {
     pub fn new(w: &Wedge, planar: Option<PlanarEdge>) -> Self {
         let plane = |p: &CentredPlane| -> BoxPlane {
             let (n, d) = p.coefficients();
-            [n.x, n.y, n.z, d, n.x.abs(), n.y.abs(), n.z.abs()]
+            n.extend(d)
         };
         // No fold planes: both open, which every box passes.
         let fold = match &w.fold {
@@ -85,7 +88,7 @@ impl ScanWedge {
         };
         Self {
             planes: std::array::from_fn(|k| w.planes.get(k).map_or(OPEN, plane)),
-            used: w.planes.len().min(BOX_PLANES),
+            used: w.planes.len().min(BOX_PLANES) as u32,
             fold,
             weight: w.weight,
             planar,
@@ -100,10 +103,10 @@ impl ScanWedge {
         let [f1, f2] = &self.fold;
         let s = Vec4::splat(slack);
         let eval = |p: &BoxPlane, q: usize| {
-            Vec4::splat(p[0]) * t.x[q]
-                + Vec4::splat(p[1]) * t.y[q]
-                + Vec4::splat(p[2]) * t.z[q]
-                + Vec4::splat(p[3])
+            Vec4::splat(p.x) * t.x[q]
+                + Vec4::splat(p.y) * t.y[q]
+                + Vec4::splat(p.z) * t.z[q]
+                + Vec4::splat(p.w)
         };
         let mut m = 0;
         for q in 0..QUADS {
@@ -119,11 +122,11 @@ impl ScanWedge {
     #[inline]
     fn inside(&self, t: &TileQuads, lanes: LaneMask) -> LaneMask {
         let mut alive = lanes;
-        for p in &self.planes[..self.used] {
+        for p in &self.planes[..self.used as usize] {
             if alive == 0 {
                 break;
             }
-            let [nx, ny, nz, d] = [p[0], p[1], p[2], p[3]].map(Vec4::splat);
+            let [nx, ny, nz, d] = p.to_array().map(Vec4::splat);
             for q in 0..QUADS {
                 let v = nx * t.x[q] + ny * t.y[q] + nz * t.z[q] + d;
                 alive &= !((v.cmplt(Vec4::ZERO).bitmask() as LaneMask) << (4 * q));
@@ -188,8 +191,9 @@ impl Boxes {
             &self.h[2][..quads],
         ];
         let mut reject = [BVec4A::splat(false); BOXES / 4];
-        for p in &w.planes[..w.used] {
-            let [nx, ny, nz, d, ax, ay, az] = p.map(Vec4::splat);
+        for p in &w.planes[..w.used as usize] {
+            let [nx, ny, nz, d] = p.to_array().map(Vec4::splat);
+            let (ax, ay, az) = (nx.abs(), ny.abs(), nz.abs());
             for q in 0..quads {
                 let v = nx * m0[q]
                     + ny * m1[q]
@@ -199,7 +203,10 @@ impl Boxes {
                 reject[q] |= v.cmplt(Vec4::ZERO);
             }
         }
-        let [f1, f2] = w.fold.map(|p| p.map(Vec4::splat));
+        let [f1, f2] = w.fold.map(|p| {
+            let [nx, ny, nz, d] = p.to_array().map(Vec4::splat);
+            [nx, ny, nz, d, nx.abs(), ny.abs(), nz.abs()]
+        });
         let s = Vec4::splat(slack);
         let mut mask = 0u64;
         for q in 0..quads {
