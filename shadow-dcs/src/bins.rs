@@ -363,21 +363,23 @@ pub(crate) fn rect_box(
     b
 }
 
-/// The (pixel, edge, weight) pairs of a square, grouped by pixel (CSR). Pixels are numbered
-/// tile by tile (row by row of tiles), then lane by lane within a tile, so that each tile's
-/// pairs are grouped on their own.
+/// The (pixel, edge, weight) pairs of a square, one list per pixel that the scan appends to
+/// directly (buffers kept from square to square). Pixels are numbered tile by tile (row by row
+/// of tiles), then lane by lane within a tile.
 #[derive(Debug, Default)]
 pub(crate) struct SquarePairs {
     rect: Option<Rect>,
     /// Tiles per row of tiles.
     across: usize,
-    /// `start[j]..start[j + 1]` indexes the entries of the square's pixel `j`.
-    start: Vec<u32>,
-    /// The pairs, by pixel.
-    entries: Vec<Pair>,
+    /// Pixels of the square (tiles times lanes, padding included).
+    pixels: usize,
+    /// Each pixel's pairs, in wedge order.
+    entries: Vec<Vec<Pair>>,
     /// With the light-plane test, each pair's test (same order as `entries`; a placeholder
-    /// that covers nothing for a pixel that takes the 3D test).
-    tests: Vec<PlanarTest>,
+    /// that covers nothing for a pixel that takes the 3D test); empty lists without.
+    tests: Vec<Vec<PlanarTest>>,
+    /// Number of pairs.
+    len: usize,
     /// What the scan did.
     pub counts: ScanCounts,
 }
@@ -413,7 +415,7 @@ impl SquarePairs {
     pub fn pixels(&self) -> impl Iterator<Item = (usize, u32, u32)> + '_ {
         let r = self.rect.expect("pairs of a square");
         let across = self.across;
-        (0..self.start.len() - 1).filter_map(move |j| {
+        (0..self.pixels).filter_map(move |j| {
             let (t, lane) = (j / LANES, j % LANES);
             let x = r.cols.0 + (t % across) as u32 * TILE_W + (lane as u32 % TILE_W);
             let y = r.rows.0 + (t / across) as u32 * TILE_H + (lane as u32 / TILE_W);
@@ -423,18 +425,23 @@ impl SquarePairs {
 
     /// The entries of pixel number `j`, and their light-plane tests (empty without).
     pub fn of(&self, j: usize) -> (&[Pair], &[PlanarTest]) {
-        let range = self.start[j] as usize..self.start[j + 1] as usize;
-        let tests = if self.tests.is_empty() {
-            &[][..]
-        } else {
-            &self.tests[range.clone()]
-        };
-        (&self.entries[range], tests)
+        (&self.entries[j], &self.tests[j])
     }
 
     /// Number of pairs.
     pub fn len(&self) -> usize {
-        self.entries.len()
+        self.len
+    }
+
+    /// Empties the lists for a square of `pixels` pixels.
+    fn reset(&mut self, pixels: usize) {
+        self.pixels = pixels;
+        self.len = 0;
+        let n = self.entries.len().max(pixels);
+        self.entries.resize_with(n, Vec::new);
+        self.tests.resize_with(n, Vec::new);
+        self.entries.iter_mut().for_each(Vec::clear);
+        self.tests.iter_mut().for_each(Vec::clear);
     }
 }
 
@@ -567,10 +574,6 @@ pub(crate) fn planar_test(
 #[derive(Default)]
 pub(crate) struct SquareScratch {
     tiles: SquareTiles,
-    /// A tile's pairs as found: lane, pair, test.
-    found: Vec<(u8, Pair)>,
-    found_tests: Vec<PlanarTest>,
-    order: Vec<u32>,
 }
 
 /// What the wedge scan reads of a frame.
@@ -604,25 +607,18 @@ pub(crate) fn square_pairs(
     scratch: &mut SquareScratch,
 ) {
     out.rect = Some(rect);
-    out.entries.clear();
-    out.tests.clear();
-    out.start.clear();
-    out.start.push(0);
     out.counts = ScanCounts::default();
-    let SquareScratch {
-        tiles,
-        found,
-        found_tests,
-        order,
-    } = scratch;
+    let SquareScratch { tiles } = scratch;
     tiles.set(input, wedges, rect, &mut out.counts);
     out.across = tiles.across;
+    out.reset(tiles.lanes.len() * LANES);
+    let mut ties = 0;
+    let mut len = 0;
     for (t, (tile, list)) in tiles.lanes.iter().zip(tiles.lists.iter()).enumerate() {
         let quads = tile.quads();
         let origin = tiles.origin(t);
-        found.clear();
-        found_tests.clear();
-        let mut ties = 0;
+        let entries = &mut out.entries[t * LANES..(t + 1) * LANES];
+        let tests = &mut out.tests[t * LANES..(t + 1) * LANES];
         for &wi in list {
             tile_pairs(
                 input,
@@ -634,44 +630,21 @@ pub(crate) fn square_pairs(
                 |j, i, k| {
                     if input.planar.is_some() {
                         match planar_test(input, wi, i, tile.l1[j]) {
-                            Some(t) => found_tests.push(t.unwrap_or(PlanarTest::NONE)),
+                            Some(t) => tests[j].push(t.unwrap_or(PlanarTest::NONE)),
                             None => {
                                 ties += 1;
                                 return;
                             }
                         }
                     }
-                    found.push((j as u8, Pair { edge: wi, k }));
+                    entries[j].push(Pair { edge: wi, k });
+                    len += 1;
                 },
             );
         }
-        out.counts.ties += ties;
-        // The tile's pairs lane by lane, each lane's in wedge order.
-        let mut count = [0u32; LANES];
-        for (j, _) in found.iter() {
-            count[*j as usize] += 1;
-        }
-        let mut at = [0u32; LANES];
-        let mut sum = 0;
-        for j in 0..LANES {
-            at[j] = sum;
-            sum += count[j];
-            out.start.push(out.entries.len() as u32 + sum);
-        }
-        order.clear();
-        order.resize(found.len(), 0);
-        for (f, (j, _)) in found.iter().enumerate() {
-            let slot = &mut at[*j as usize];
-            order[*slot as usize] = f as u32;
-            *slot += 1;
-        }
-        out.entries
-            .extend(order.iter().map(|&f| found[f as usize].1));
-        if !found_tests.is_empty() {
-            out.tests
-                .extend(order.iter().map(|&f| found_tests[f as usize]));
-        }
     }
+    out.counts.ties += ties;
+    out.len = len;
 }
 
 #[cfg(test)]
