@@ -190,6 +190,22 @@ impl LightShape {
         }
     }
 
+    /// [`LightShape::range`] for two offsets `d1`, `d2` of one normal, with the same values as
+    /// two calls: for a polygon the dot products are taken once, and since rounding is
+    /// monotonic, the extremes of the sums `n . q + d` are the sums of the extremes of `n . q`.
+    pub fn ranges(&self, n: DVec3, d1: f64, d2: f64) -> [(f64, f64); 2] {
+        match &self.exact {
+            Exact::Vertices(v) => {
+                let (lo, hi) = v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |r, q| {
+                    let f = n.dot(*q);
+                    (r.0.min(f), r.1.max(f))
+                });
+                [(lo + d1, hi + d1), (lo + d2, hi + d2)]
+            }
+            _ => [self.range(n, d1), self.range(n, d2)],
+        }
+    }
+
     /// Minimum and maximum of `n . q + d` over the light's points `q` (exact).
     pub fn range(&self, n: DVec3, d: f64) -> (f64, f64) {
         match &self.exact {
@@ -210,6 +226,42 @@ impl LightShape {
                 let f = n.dot(*center) + d;
                 let r = n.length() * radius;
                 (f - r, f + r)
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use shadow_core::light::{DiskLight, RectLight, SphereLight};
+    use shadow_core::prelude::Radiance;
+
+    /// `ranges` gives exactly the values of two `range` calls (rectangle, disk, sphere), with
+    /// offsets of very different sizes so that the sums round.
+    #[test]
+    fn ranges_equal_two_range_calls() {
+        let r = || Radiance::constant(Vec3::ONE).unwrap();
+        let rect =
+            RectLight::facing(Vec3::new(0.2, 3.0, -0.1), Vec3::NEG_Y, 1.2, 0.8, r()).unwrap();
+        let disk = DiskLight::new(Vec3::new(-1.0, 2.5, 0.3), Vec3::NEG_Y, 0.7, r()).unwrap();
+        let sphere = SphereLight::new(Vec3::new(0.5, 4.0, 1.0), 0.4, r()).unwrap();
+        let lights: [&dyn AreaLight; 3] = [&rect, &disk, &sphere];
+        let mut seed = 7u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for light in lights {
+            let shape = LightShape::new(light, "test").unwrap();
+            for k in 0..2000 {
+                let n = DVec3::new(next(), next(), next());
+                let scale = 10f64.powi(k % 9 - 4);
+                let (d1, d2) = (next() * scale, next() * 3.0);
+                let want = [shape.range(n, d1), shape.range(n, d2)];
+                assert_eq!(shape.ranges(n, d1, d2), want, "{n} {d1} {d2}");
             }
         }
     }

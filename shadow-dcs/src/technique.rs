@@ -490,8 +490,8 @@ impl Dcs {
     /// above the tangent plane both from the surface point and from the offset origin.
     fn horizon(shape: &LightShape, s: &ViewSample, origin: Vec3) -> Horizon {
         let n = s.geometric_normal.as_dvec3();
-        let (lo1, hi1) = shape.range(n, -n.dot(s.position.as_dvec3()));
-        let (lo2, hi2) = shape.range(n, -n.dot(origin.as_dvec3()));
+        let [(lo1, hi1), (lo2, hi2)] =
+            shape.ranges(n, -n.dot(s.position.as_dvec3()), -n.dot(origin.as_dvec3()));
         let reach = shape.center.as_dvec3().length() + f64::from(shape.radius);
         let bound = HORIZON_BOUND
             * n.length()
