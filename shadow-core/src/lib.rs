@@ -52,6 +52,7 @@ pub mod offset;
 pub mod preset;
 pub mod procedural;
 pub mod raster;
+mod rounding;
 pub mod sampling;
 pub mod scene;
 pub mod scenes;

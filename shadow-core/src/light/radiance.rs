@@ -6,6 +6,7 @@ use std::sync::Arc;
 use glam::{Affine2, Vec2, Vec3};
 
 use super::LightError;
+use crate::rounding::floor_f32;
 
 /// Radiance of a light.
 #[derive(Debug, Clone, PartialEq)]
@@ -125,7 +126,7 @@ impl TexturedRadiance {
         let st = self.texture_from_light.transform_point2(uv);
         let x = st.x * self.width as f32 - 0.5;
         let y = st.y * self.height as f32 - 0.5;
-        let (x0, y0) = (floor(x), floor(y));
+        let (x0, y0) = (floor_f32(x), floor_f32(y));
         let (fx, fy) = (x - x0, y - y0);
         let (xi, yi) = (x0 as i64, y0 as i64);
         let (xa, xb) = (wrap(xi, self.width), wrap(xi.saturating_add(1), self.width));
@@ -138,20 +139,6 @@ impl TexturedRadiance {
         let a = texel(xa, ya).lerp(texel(xb, ya), fx);
         let b = texel(xa, yb).lerp(texel(xb, yb), fx);
         a.lerp(b, fy) * self.scale
-    }
-}
-
-/// `x.floor()` without a library call on targets without a rounding instruction (the
-/// baseline x86-64 has none): truncation, one down for negative fractions. Equal to
-/// `f32::floor` for every finite `x` (above `2^23` every float is an integer, which the
-/// round trip through `i64` keeps); non-finite values go through `f32::floor`.
-#[inline]
-fn floor(x: f32) -> f32 {
-    if x.abs() < 9.0e18 {
-        let t = x as i64 as f32;
-        if t > x { t - 1.0 } else { t }
-    } else {
-        x.floor()
     }
 }
 
@@ -204,13 +191,6 @@ mod tests {
             let uv = Vec2::new(r(0) * 6.0 - 3.0, r(1) * 6.0 - 3.0);
             assert_eq!(tex.at(uv), plain(uv), "uv {uv}");
         }
-        for x in [
-            0.0, -0.0, 0.5, -0.5, -1.0, 2.75, -2.75, 8388607.5, -8388609.0, 1e20, -1e20,
-        ] {
-            assert_eq!(floor(x), x.floor(), "{x}");
-        }
-        assert!(floor(f32::NAN).is_nan());
-        assert_eq!(floor(f32::NEG_INFINITY), f32::NEG_INFINITY);
     }
 
     #[test]

@@ -4,6 +4,7 @@
 use glam::{DVec2, Vec3};
 
 use super::RasterView;
+use crate::rounding::{ceil_f64, floor_f64};
 
 /// A screen-space triangle ready for scan conversion.
 #[derive(Debug, Clone)]
@@ -76,8 +77,8 @@ impl ScreenTriangle {
                 hi = hi.min(x - 0.5);
             }
         }
-        let x0 = (lo.floor() - 1.0).max(self.xmin as f64);
-        let x1 = (hi.ceil() + 1.0).min(self.xmax as f64);
+        let x0 = (floor_f64(lo) - 1.0).max(self.xmin as f64);
+        let x1 = (ceil_f64(hi) + 1.0).min(self.xmax as f64);
         (x0 <= x1).then_some((x0 as u32, x1 as u32))
     }
 
@@ -115,8 +116,8 @@ impl ScreenTriangle {
         if !(eps < 0.25) {
             return self.row_span_exact(y);
         }
-        let a = (lo - eps).ceil().max(self.xmin as f64);
-        let b = (hi + eps).floor().min(self.xmax as f64);
+        let a = ceil_f64(lo - eps).max(self.xmin as f64);
+        let b = floor_f64(hi + eps).min(self.xmax as f64);
         if !(a <= b) {
             return None;
         }
