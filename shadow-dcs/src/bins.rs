@@ -513,15 +513,16 @@ pub(crate) fn tile_pairs(
     let wedge = &input.wedges[wi as usize];
     counts.scanned += u64::from(tile.active.count_ones());
     // Where the edge cannot be a silhouette of the view sample (its face planes surely differ
-    // in sign there), the weight is zero: most tiles a wedge's box test keeps have no such
-    // view sample left.
-    if wedge.fold_lanes(quads, input.slack) & tile.active == 0 {
+    // in sign there), the weight is zero: those view samples take neither the weight nor the
+    // planes, and most tiles a wedge's box test keeps have none left.
+    let fold = wedge.fold_lanes(quads, input.slack) & tile.active;
+    if fold == 0 {
         return;
     }
     let fast = wedge.weight.as_ref().and_then(|f| f.weight_lanes(quads));
     let candidates = match &fast {
-        Some(f) => tile.active & (f.nonzero | !f.certain),
-        None => tile.active,
+        Some(f) => fold & (f.nonzero | !f.certain),
+        None => fold,
     };
     let inside = wedge.inside(quads, candidates);
     let w = input.width as usize;
