@@ -10,15 +10,10 @@
 /// Largest magnitude that goes through `i64` (below `2^63`, with room to spare).
 const THROUGH_I64: f64 = 9.0e18;
 
-/// `x.floor()`.
+/// `x.floor()`: the floor of a float is a float, so the double-precision one is exact.
 #[inline]
 pub(crate) fn floor_f32(x: f32) -> f32 {
-    if f64::from(x.abs()) < THROUGH_I64 {
-        let t = x as i64 as f32;
-        if t > x { t - 1.0 } else { t }
-    } else {
-        x.floor()
-    }
+    floor_f64(f64::from(x)) as f32
 }
 
 /// `x.floor()`.

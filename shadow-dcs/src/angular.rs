@@ -462,15 +462,20 @@ mod tests {
         }
     }
 
-    fn candidates_hold_every_covered_sample_of(count: u32) {
-        let light = RectLight::facing(
+    /// The 1.2 x 0.8 rectangle light of these tests, facing `normal`.
+    fn test_light(normal: Vec3) -> RectLight {
+        RectLight::facing(
             Vec3::new(0.2, 3.0, -0.1),
-            Vec3::NEG_Y,
+            normal,
             1.2,
             0.8,
             Radiance::constant(Vec3::ONE).unwrap(),
         )
-        .unwrap();
+        .unwrap()
+    }
+
+    fn candidates_hold_every_covered_sample_of(count: u32) {
+        let light = test_light(Vec3::NEG_Y);
         let shape = LightShape::new(&light, "test").unwrap();
         let plane = shape.plane.clone().unwrap();
         let sampler = LightSampler::new(SamplingStrategy::Stratified, count, 3).unwrap();
@@ -567,14 +572,7 @@ mod tests {
         use crate::centred::CentredEdge;
         use crate::edges::SceneEdge;
         use crate::planar::{PlanarEdge, PlanarSamples};
-        let light = RectLight::facing(
-            Vec3::new(0.2, 3.0, -0.1),
-            Vec3::new(0.1, -1.0, 0.05),
-            1.2,
-            0.8,
-            Radiance::constant(Vec3::ONE).unwrap(),
-        )
-        .unwrap();
+        let light = test_light(Vec3::new(0.1, -1.0, 0.05));
         let shape = LightShape::new(&light, "test").unwrap();
         let plane = shape.plane.clone().unwrap();
         let sampler = LightSampler::new(SamplingStrategy::Stratified, 64, 3).unwrap();

@@ -103,6 +103,23 @@ pub(crate) fn run<C: Counters>(
     Ok(())
 }
 
+/// The range checks every packing must pass, `get` reading counter `i`: an add past the top
+/// and a subtraction below zero fail, and an initial value too wide for the counters is refused.
+#[cfg(test)]
+pub(crate) fn check_range_errors<C: Counters>(c: &mut C, get: impl Fn(&C, usize) -> u64) {
+    c.reset(8, 16, 250).unwrap();
+    let mask = [0b10u64];
+    c.add(&mask, 5).unwrap();
+    assert_eq!(get(c, 1), 255);
+    assert_eq!(c.add(&mask, 1), Err(OutOfRange));
+    c.reset(16, 8, 1).unwrap();
+    c.sub(&[0b100], 1).unwrap();
+    assert_eq!(get(c, 2), 0);
+    assert_eq!(c.sub(&[0b100], 1), Err(OutOfRange));
+    assert_eq!(get(c, 3), 1);
+    assert!(c.reset(8, 4, 256).is_err());
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
