@@ -1,0 +1,61 @@
+//! A profiling driver: prepares one technique on one built-in scene and runs a given number of
+//! estimates, nothing else, so that a profiler's count for `RUNS = 1` minus its count for
+//! `RUNS = 0` is the cost of exactly one estimate (`scripts/dcs_instructions.sh` does this under
+//! `valgrind --tool=callgrind`):
+//!
+//!     cargo run --release -p shadow-dcs --example dcs_estimates -- [SCENE] [SIZE] [TECHNIQUE] [RUNS]
+//!
+//! `TECHNIQUE` is a DCS preset name (`dcs-64` by default) or `reference` (the reference on the
+//! samples of `dcs-64`: 64 stratified samples, seed 1, as `dcs_bench` compares them). Prints the
+//! best wall time of the runs and, for a DCS preset, the counters of the last one, which tell
+//! two builds apart when they should do the same work (pairs, covered updates).
+
+use std::time::Instant;
+
+use shadow_core::prelude::*;
+use shadow_ref::Reference;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let scene = args.first().map_or("bunny", String::as_str);
+    let size: u32 = args.get(1).map_or(Ok(512), |s| s.parse())?;
+    let name = args.get(2).map_or("dcs-64", String::as_str);
+    let runs: u32 = args.get(3).map_or(Ok(1), |s| s.parse())?;
+    let setup = shadow_core::scenes::builtin(scene)?;
+    let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), size, size)?;
+    let mut technique: Box<dyn ShadowTechnique> = if name == "reference" {
+        let sampler = LightSampler::new(SamplingStrategy::Stratified, 64, 1)?;
+        Box::new(Reference::same_samples(sampler))
+    } else {
+        let preset = shadow_dcs::presets()
+            .into_iter()
+            .find(|p| p.name == name)
+            .ok_or_else(|| format!("{name}: neither `reference` nor a DCS preset"))?;
+        (preset.make)(1)
+    };
+    technique.prepare(setup.scene.clone(), setup.lights[0].clone())?;
+    let mut best = f64::INFINITY;
+    let mut last = None;
+    for _ in 0..runs {
+        let t0 = Instant::now();
+        let e = technique.estimate(&view)?;
+        best = best.min(t0.elapsed().as_secs_f64());
+        last = Some(e);
+    }
+    match last {
+        Some(e) => {
+            println!("{name} on {scene} {size}x{size}: best of {runs} runs {best:.4} s");
+            let counters: Vec<String> = e
+                .stats
+                .counters
+                .iter()
+                .map(|(k, v)| format!("{k}={v}"))
+                .collect();
+            if !counters.is_empty() {
+                println!("{}", counters.join(" "));
+            }
+        }
+        None => println!("{name} on {scene} {size}x{size}: prepared, no estimate"),
+    }
+    Ok(())
+}
