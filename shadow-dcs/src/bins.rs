@@ -511,7 +511,6 @@ pub(crate) fn tile_pairs(
     mut pair: impl FnMut(usize, usize, i32),
 ) {
     let wedge = &input.wedges[wi as usize];
-    counts.scanned += u64::from(tile.active.count_ones());
     // Where the edge cannot be a silhouette of the view sample (its face planes surely differ
     // in sign there), the weight is zero: those view samples take neither the weight nor the
     // planes, and most tiles a wedge's box test keeps have none left.
@@ -618,6 +617,7 @@ pub(crate) fn square_pairs(
     for (t, (tile, list)) in tiles.lanes.iter().zip(tiles.lists.iter()).enumerate() {
         let quads = tile.quads();
         let origin = tiles.origin(t);
+        out.counts.scanned += u64::from(tile.active.count_ones()) * list.len() as u64;
         let entries = &mut out.entries[t * LANES..(t + 1) * LANES];
         let tests = &mut out.tests[t * LANES..(t + 1) * LANES];
         for &wi in list {
