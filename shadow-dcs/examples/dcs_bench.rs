@@ -9,11 +9,11 @@
 //! its last run, the ratio and the per-sample agreement; fails when agreement is below 99.9%
 //! (below the preset's own bound for a named preset: 99% for `dcs-64-discrete`).
 
-use std::time::Instant;
-
 use shadow_core::prelude::*;
 use shadow_dcs::Dcs;
 use shadow_ref::Reference;
+
+mod common;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -21,17 +21,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let size: u32 = args.get(1).map_or(Ok(512), |s| s.parse())?;
     let samples = args.get(2).map_or("64", String::as_str);
     let runs: u32 = args.get(3).map_or(Ok(5), |s| s.parse())?;
-    let setup = shadow_core::scenes::builtin(scene)?;
-    let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), size, size)?;
+    let (setup, view) = common::scene_and_view(scene, size)?;
     let light = setup.lights[0].clone();
     let mut min_agreement = 0.999;
     let mut dcs: Box<dyn ShadowTechnique> = match samples.parse::<u32>() {
         Ok(n) => Box::new(Dcs::new(n, SamplingStrategy::Stratified, 1)?),
         Err(_) => {
-            let preset = shadow_dcs::presets()
-                .into_iter()
-                .find(|p| p.name == samples)
-                .ok_or_else(|| format!("{samples}: neither a sample count nor a DCS preset"))?;
+            let preset = common::preset(samples, "a sample count")?;
             if let Some(a) = (preset.budget)(scene).and_then(|b| b.min_sample_agreement) {
                 min_agreement = a;
             }
@@ -43,17 +39,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let n = sampler.count();
     let mut r = Reference::same_samples(sampler);
     r.prepare(setup.scene.clone(), light)?;
-    let best = |t: &mut dyn ShadowTechnique| -> Result<(f64, Estimate), TechniqueError> {
-        let mut secs = f64::INFINITY;
-        let mut last = None;
-        for _ in 0..runs {
-            let t0 = Instant::now();
-            let e = t.estimate(&view)?;
-            secs = secs.min(t0.elapsed().as_secs_f64());
-            last = Some(e);
-        }
-        Ok((secs, last.expect("at least one run")))
-    };
+    let best =
+        |t: &mut dyn ShadowTechnique| -> Result<(f64, Estimate), Box<dyn std::error::Error>> {
+            let (secs, last) = common::best_of(runs.max(1), t, &view)?;
+            Ok((secs, last.ok_or("no estimate")?))
+        };
     let (td, ed) = best(dcs.as_mut())?;
     let (tr, er) = best(&mut r)?;
     let m = shadow_core::metrics::compare(&ed.visibility, &er.visibility)?;

@@ -10,10 +10,10 @@
 //! best wall time of the runs and, for a DCS preset, the counters of the last one, which tell
 //! two builds apart when they should do the same work (pairs, covered updates).
 
-use std::time::Instant;
-
 use shadow_core::prelude::*;
 use shadow_ref::Reference;
+
+mod common;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -21,27 +21,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let size: u32 = args.get(1).map_or(Ok(512), |s| s.parse())?;
     let name = args.get(2).map_or("dcs-64", String::as_str);
     let runs: u32 = args.get(3).map_or(Ok(1), |s| s.parse())?;
-    let setup = shadow_core::scenes::builtin(scene)?;
-    let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), size, size)?;
+    let (setup, view) = common::scene_and_view(scene, size)?;
     let mut technique: Box<dyn ShadowTechnique> = if name == "reference" {
         let sampler = LightSampler::new(SamplingStrategy::Stratified, 64, 1)?;
         Box::new(Reference::same_samples(sampler))
     } else {
-        let preset = shadow_dcs::presets()
-            .into_iter()
-            .find(|p| p.name == name)
-            .ok_or_else(|| format!("{name}: neither `reference` nor a DCS preset"))?;
-        (preset.make)(1)
+        (common::preset(name, "`reference`")?.make)(1)
     };
     technique.prepare(setup.scene.clone(), setup.lights[0].clone())?;
-    let mut best = f64::INFINITY;
-    let mut last = None;
-    for _ in 0..runs {
-        let t0 = Instant::now();
-        let e = technique.estimate(&view)?;
-        best = best.min(t0.elapsed().as_secs_f64());
-        last = Some(e);
-    }
+    let (best, last) = common::best_of(runs, technique.as_mut(), &view)?;
     match last {
         Some(e) => {
             println!("{name} on {scene} {size}x{size}: best of {runs} runs {best:.4} s");
