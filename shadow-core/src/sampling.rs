@@ -59,7 +59,16 @@ pub fn hash_words(words: &[u64]) -> u64 {
 
 /// A float in `[0, 1)` from the top 24 bits of a hash.
 pub fn unit_float(h: u64) -> f32 {
-    (h >> 40) as f32 * (1.0 / 16_777_216.0)
+    // Through `i32`: the 24 bits convert exactly either way, and the baseline x86-64 has a
+    // single instruction for a signed conversion but a sequence for an unsigned 64-bit one.
+    (h >> 40) as i32 as f32 * (1.0 / 16_777_216.0)
+}
+
+/// `x.min(ONE_MINUS)` for the non-NaN values of a jittered sample, as one `minss` (the NaN
+/// handling of `f32::min` costs three more instructions per coordinate).
+#[inline(always)]
+fn below_one(x: f32) -> f32 {
+    if x < ONE_MINUS { x } else { ONE_MINUS }
 }
 
 const ONE_MINUS: f32 = 1.0 - 1.0 / 16_777_216.0;
@@ -76,6 +85,8 @@ pub struct LightSampler {
     /// Each cell's hash key, `mix64(k ^ CELL_SALT)`: the part of a jittered sample's hash that
     /// does not depend on the set, computed once rather than per pixel.
     cell_keys: Vec<u64>,
+    /// Each cell's corner `(k % grid.x, k / grid.x)` in cell units.
+    cell_corners: Vec<Vec2>,
 }
 
 /// Salt of the cell index in a jittered sample's hash.
@@ -99,6 +110,9 @@ impl LightSampler {
             sets: Vec::new(),
             cell_keys: (0..u64::from(count))
                 .map(|k| mix64(k ^ CELL_SALT))
+                .collect(),
+            cell_corners: (0..count)
+                .map(|k| Vec2::new((k % grid.x) as f32, (k / grid.x) as f32))
                 .collect(),
         };
         s.sets = match strategy {
@@ -142,21 +156,34 @@ impl LightSampler {
         out
     }
 
-    /// Appends the jittered set of `base` (a hash of the set's key) to `out`.
+    /// Appends the jittered set of `base` (a hash of the set's key) to `out`: sample `k` is
+    /// cell `(k % grid.x, k / grid.x)` jittered by `mix64(base ^ cell_keys[k])`.
     fn jittered_into(&self, base: u64, out: &mut Vec<Vec2>) {
-        // Row by row: sample `k` is cell `(k % grid.x, k / grid.x)`, without a division each.
-        let (gx, gy) = (self.grid.x as f32, self.grid.y as f32);
-        for (cy, row) in self.cell_keys.chunks(self.grid.x as usize).enumerate() {
-            for (cx, key) in row.iter().enumerate() {
-                let h = mix64(base ^ key);
-                let jx = unit_float(h);
-                let jy = unit_float(mix64(h));
-                out.push(Vec2::new(
-                    ((cx as f32 + jx) / gx).min(ONE_MINUS),
-                    ((cy as f32 + jy) / gy).min(ONE_MINUS),
-                ));
-            }
+        let g = self.grid.as_vec2();
+        if self.grid.x.is_power_of_two() && self.grid.y.is_power_of_two() {
+            // Dividing by a power of two and multiplying by its reciprocal round alike.
+            let inv = g.recip();
+            self.jitter_cells(base, out, |c| c * inv);
+        } else {
+            self.jitter_cells(base, out, |c| c / g);
         }
+    }
+
+    /// [`LightSampler::jittered_into`] with the division by the grid given as `scale`; one
+    /// pass over the cells' keys and corners, which `extend` writes without a capacity check
+    /// per sample.
+    #[inline(always)]
+    fn jitter_cells(&self, base: u64, out: &mut Vec<Vec2>, scale: impl Fn(Vec2) -> Vec2) {
+        out.extend(
+            self.cell_keys
+                .iter()
+                .zip(&self.cell_corners)
+                .map(|(key, corner)| {
+                    let h = mix64(base ^ key);
+                    let s = scale(*corner + Vec2::new(unit_float(h), unit_float(mix64(h))));
+                    Vec2::new(below_one(s.x), below_one(s.y))
+                }),
+        );
     }
 
     /// The unit-square samples of pixel `pixel` (x, y), written into `out` (cleared first).
@@ -221,7 +248,7 @@ mod tests {
     /// hash of the pixel's key and `k` (the per-cell key table only caches part of it).
     #[test]
     fn stratified_samples_follow_the_per_sample_hash() {
-        for n in [1, 7, 64, 128] {
+        for n in [1, 7, 12, 64, 128, 1000] {
             let s = LightSampler::new(SamplingStrategy::Stratified, n, 9).unwrap();
             let g = s.grid();
             let mut out = Vec::new();
