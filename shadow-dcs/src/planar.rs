@@ -19,7 +19,7 @@
 //! light without gap or overlap whatever the rounding. Agreement with the 3D form of
 //! [`EdgeTest`] up to rounding at ties is tested below.
 
-use glam::{DVec3, Vec3, Vec4};
+use glam::{DVec3, Vec2, Vec3, Vec4};
 
 use crate::edges::SceneEdge;
 
@@ -229,16 +229,55 @@ impl PlanarSamples {
 
     /// Sets the samples `positions` (world space) around `c` on axes `u`, `v`.
     pub fn set(&mut self, positions: &[Vec3], c: Vec3, u: Vec3, v: Vec3) {
-        let padded = positions.len().div_ceil(64) * 64;
-        for w in [&mut self.x, &mut self.y] {
-            w.clear();
-            w.resize(padded, 0.0);
-        }
+        self.clear_to(positions.len());
         for (k, s) in positions.iter().enumerate() {
             let d = *s - c;
             self.x[k] = d.dot(u);
             self.y[k] = d.dot(v);
         }
+    }
+
+    /// Sets the samples of a rectangle light straight from its unit samples, without world
+    /// positions: the light's point of `u` is `c + a half_u + b half_v` with `a = 2 u.x - 1`,
+    /// `b = 2 u.y - 1`, so its coordinates on the light plane's axes are the affine map
+    /// `x = a map.x + b map.y`, `y = a map.z + b map.w`, where `map` holds the half sides' own
+    /// coordinates ([`RectMap`]). The same points as [`PlanarSamples::set`] on the light's
+    /// positions, up to the rounding that those positions add.
+    pub fn set_rect(&mut self, units: &[Vec2], map: &RectMap) {
+        self.clear_to(units.len());
+        let [hux, hvx, huy, hvy] = map.0;
+        for ((x, y), u) in self.x.iter_mut().zip(self.y.iter_mut()).zip(units) {
+            let (a, b) = (2.0 * u.x - 1.0, 2.0 * u.y - 1.0);
+            *x = a * hux + b * hvx;
+            *y = a * huy + b * hvy;
+        }
+    }
+
+    /// `n` samples' room, padded with zeros to whole words.
+    fn clear_to(&mut self, n: usize) {
+        let padded = n.div_ceil(64) * 64;
+        for w in [&mut self.x, &mut self.y] {
+            w.clear();
+            w.resize(padded, 0.0);
+        }
+    }
+}
+
+/// A rectangle light's half sides in its light plane's coordinates: `[half_u . u, half_v . u,
+/// half_u . v, half_v . v]` for the plane's axes `u`, `v` (taken in double precision).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct RectMap(pub [f32; 4]);
+
+impl RectMap {
+    /// The map of a rectangle with half sides `half_u`, `half_v` on the plane axes `u`, `v`.
+    pub fn new(half_u: Vec3, half_v: Vec3, u: Vec3, v: Vec3) -> Self {
+        let (hu, hv, u, v) = (
+            half_u.as_dvec3(),
+            half_v.as_dvec3(),
+            u.as_dvec3(),
+            v.as_dvec3(),
+        );
+        Self([hu.dot(u), hv.dot(u), hu.dot(v), hv.dot(v)].map(|x| x as f32))
     }
 }
 
@@ -251,6 +290,54 @@ mod tests {
 
     fn edge(a: DVec3, b: DVec3) -> SceneEdge {
         SceneEdge::boundary(a, b, (a + b) * 0.5 + DVec3::new(0.0, 0.0, 0.1))
+    }
+
+    /// A rectangle light's light-plane coordinates straight from its unit samples
+    /// ([`PlanarSamples::set_rect`]) equal those of its world positions
+    /// ([`PlanarSamples::set`]) up to the positions' rounding: tilted, far from the origin too,
+    /// with sides orthogonal only within the light's tolerance, the normal either way round.
+    #[test]
+    fn rectangle_coordinates_from_unit_samples_equal_those_of_positions() {
+        use crate::light_shape::LightShape;
+        use shadow_core::light::{AreaLight, RectLight};
+        use shadow_core::prelude::Radiance;
+        for case in 0..6u64 {
+            let r = |i: u64| unit_float(hash_words(&[case, i])) * 2.0 - 1.0;
+            let offset = [0.0, 50.0, 1e3][case as usize % 3];
+            let center = Vec3::new(r(0), 3.0 + r(1), r(2)) + Vec3::splat(offset);
+            let half_u = Vec3::new(0.5 + 0.3 * r(3), 0.2 * r(4), 0.2 * r(5));
+            let mut half_v = half_u.cross(Vec3::new(r(6), 1.0, r(7))).normalize() * 0.4;
+            half_v += half_u.normalize() * (0.4 * 5e-5);
+            if case % 2 == 1 {
+                half_v = -half_v;
+            }
+            let radiance = Radiance::constant(Vec3::ONE).unwrap();
+            let light = RectLight::new(center, half_u, half_v, radiance).unwrap();
+            let shape = LightShape::new(&light, "test").unwrap();
+            let pl = shape.plane.as_ref().unwrap();
+            let units: Vec<Vec2> = (0..100u64)
+                .map(|k| {
+                    let h = hash_words(&[case, 100 + k]);
+                    Vec2::new(unit_float(h), unit_float(h << 24))
+                })
+                .collect();
+            let mut positions = Vec::new();
+            light.positions_into(&units, &mut positions);
+            let (mut a, mut b) = (PlanarSamples::default(), PlanarSamples::default());
+            a.set(&positions, shape.center, pl.u, pl.v);
+            b.set_rect(&units, &RectMap::new(half_u, half_v, pl.u, pl.v));
+            assert_eq!((a.x.len(), b.x.len()), (128, 128));
+            let tol = 4.0 * f32::EPSILON * (center.length() + 1.0);
+            for k in 0..units.len() {
+                let (dx, dy) = ((a.x[k] - b.x[k]).abs(), (a.y[k] - b.y[k]).abs());
+                assert!(
+                    dx <= tol && dy <= tol,
+                    "case {case} sample {k}: {dx} {dy} > {tol}"
+                );
+            }
+            // The padding is zero either way.
+            assert!(b.x[units.len()..].iter().all(|x| *x == 0.0));
+        }
     }
 
     /// The light-plane test covers the samples the 3D test covers, up to rounding at ties, far

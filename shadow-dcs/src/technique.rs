@@ -34,7 +34,7 @@ use glam::{DVec3, UVec2, Vec2, Vec3};
 use rayon::prelude::*;
 use serde_json::json;
 use shadow_core::direct::pixel_direct;
-use shadow_core::light::{LightKind, LightSample};
+use shadow_core::light::{LightGeometry, LightKind, LightSample};
 use shadow_core::offset::RayOffset;
 use shadow_core::prelude::*;
 use shadow_core::technique::{Capabilities, Processor, SceneRef};
@@ -52,7 +52,7 @@ use crate::coverage::{EdgeTest, RelativePolygon, RelativeSamples};
 use crate::discrete::{CoveredSamples, DiscreteTables, LineMasks};
 use crate::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
 use crate::light_shape::LightShape;
-use crate::planar::{PlanarEdge, PlanarSamples, PlanarTest};
+use crate::planar::{PlanarEdge, PlanarSamples, PlanarTest, RectMap};
 use crate::wedges::{FOLD_SLACK, Pair, wedges};
 
 /// What per-sample visibility an estimate returns.
@@ -86,6 +86,9 @@ struct Prepared {
     scan: Vec<ScanWedge>,
     /// The light-plane form of the silhouette edges, for planar lights.
     planar: Option<PlanarLight>,
+    /// A constant rectangle light's half sides on the light plane's axes: its samples' plane
+    /// coordinates come straight from the unit samples.
+    rect: Option<RectMap>,
 }
 
 /// A planar light's frame, for the light-plane test ([`crate::planar`]).
@@ -827,13 +830,20 @@ impl Dcs {
         let light = p.light.as_ref();
         scratch.samples.clear();
         scratch.positions.clear();
+        // A constant rectangle light wholly above the receiver needs no world positions: the
+        // light-plane coordinates are an affine map of the unit samples (positions are still
+        // made under debug assertions, to check the horizon).
+        let rect = match (&p.rect, &p.planar, planar && all_above) {
+            (Some(r), Some(_), true) => Some(r),
+            _ => None,
+        };
         if light.is_textured() {
             // The radiances weigh the visibilities (eq. 2).
             light.sample_into(&scratch.units, &mut scratch.samples);
             scratch
                 .positions
                 .extend(scratch.samples.iter().map(|l| l.position));
-        } else {
+        } else if rect.is_none() || cfg!(debug_assertions) {
             light.positions_into(&scratch.units, &mut scratch.positions);
         }
         // Samples above the horizon (the reference's rule), every one when the whole light is
@@ -859,9 +869,14 @@ impl Dcs {
         scratch.weights.clear();
         match (&p.planar, planar) {
             (Some(pl), true) => {
-                scratch
-                    .planar_samples
-                    .set(&scratch.positions, p.shape.center, pl.u, pl.v);
+                match rect {
+                    Some(r) => scratch.planar_samples.set_rect(&scratch.units, r),
+                    None => {
+                        scratch
+                            .planar_samples
+                            .set(&scratch.positions, p.shape.center, pl.u, pl.v);
+                    }
+                }
                 if indexed {
                     scratch.angular.build_planar(&scratch.planar_samples, n);
                 }
@@ -1229,6 +1244,12 @@ impl ShadowTechnique for Dcs {
             v: pl.v,
             normal: pl.u.cross(pl.v),
         });
+        let rect = match (light.geometry(), &shape.plane, light.is_textured()) {
+            (LightGeometry::Rectangle { half_u, half_v, .. }, Some(pl), false) => {
+                Some(RectMap::new(half_u, half_v, pl.u, pl.v))
+            }
+            _ => None,
+        };
         let scan = wedges
             .par_iter()
             .map(|w| {
@@ -1241,6 +1262,7 @@ impl ShadowTechnique for Dcs {
             .collect();
         self.prepared = Some(Prepared {
             planar,
+            rect,
             scan,
             polygon,
             centred_edges,
