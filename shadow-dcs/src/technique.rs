@@ -833,10 +833,7 @@ impl Dcs {
         // A constant rectangle light wholly above the receiver needs no world positions: the
         // light-plane coordinates are an affine map of the unit samples (positions are still
         // made under debug assertions, to check the horizon).
-        let rect = match (&p.rect, &p.planar, planar && all_above) {
-            (Some(r), Some(_), true) => Some(r),
-            _ => None,
-        };
+        let rect = p.rect.as_ref().filter(|_| planar && all_above);
         if light.is_textured() {
             // The radiances weigh the visibilities (eq. 2).
             light.sample_into(&scratch.units, &mut scratch.samples);
