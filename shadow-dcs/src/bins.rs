@@ -373,10 +373,11 @@ pub(crate) struct SquarePairs {
     across: usize,
     /// Pixels of the square (tiles times lanes, padding included).
     pixels: usize,
-    /// Each pixel's pairs, in wedge order.
+    /// Each pixel's pairs for the 3D test, in wedge order (empty lists for pixels that take
+    /// the light-plane test).
     entries: Vec<Vec<Pair>>,
-    /// With the light-plane test, each pair's test (same order as `entries`; a placeholder
-    /// that covers nothing for a pixel that takes the 3D test); empty lists without.
+    /// Each pixel's pairs for the light-plane test, in wedge order, each test carrying its
+    /// pair's weight (empty lists for pixels that take the 3D test).
     tests: Vec<Vec<PlanarTest>>,
     /// Number of pairs.
     len: usize,
@@ -423,7 +424,8 @@ impl SquarePairs {
         })
     }
 
-    /// The entries of pixel number `j`, and their light-plane tests (empty without).
+    /// The pairs of pixel number `j`: for the 3D test, and for the light-plane test (one of
+    /// the two is empty).
     pub fn of(&self, j: usize) -> (&[Pair], &[PlanarTest]) {
         (&self.entries[j], &self.tests[j])
     }
@@ -629,16 +631,17 @@ pub(crate) fn square_pairs(
                 origin,
                 &mut out.counts,
                 |j, i, k| {
-                    if input.planar.is_some() {
-                        match planar_test(input, wi, i, tile.l1[j]) {
-                            Some(t) => tests[j].push(t.unwrap_or(PlanarTest::NONE)),
-                            None => {
-                                ties += 1;
-                                return;
-                            }
+                    match planar_test(input, wi, i, tile.l1[j]) {
+                        Some(Some(mut t)) => {
+                            t.k = k;
+                            tests[j].push(t);
+                        }
+                        Some(None) => entries[j].push(Pair { edge: wi, k }),
+                        None => {
+                            ties += 1;
+                            return;
                         }
                     }
-                    entries[j].push(Pair { edge: wi, k });
                     len += 1;
                 },
             );

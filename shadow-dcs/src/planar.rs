@@ -96,6 +96,7 @@ impl PlanarEdge {
             cx,
             cy,
             k2: if positive { mp } else { -mp },
+            k: 0,
         })
     }
 }
@@ -112,6 +113,9 @@ pub(crate) struct PlanarTest {
     cy: Vec4,
     /// The constant of the last form.
     k2: f32,
+    /// The pair's weight `k_e(p)` (it fills the padding after `k2`, so a pixel's pairs need no
+    /// second list).
+    pub k: i32,
 }
 
 impl PlanarTest {
@@ -120,6 +124,7 @@ impl PlanarTest {
         cx: Vec4::ZERO,
         cy: Vec4::ZERO,
         k2: 0.0,
+        k: 0,
     };
 
     /// The sector's sides: the covered cone is `a . s > 0`, `b . s < 0`.

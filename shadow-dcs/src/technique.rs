@@ -541,25 +541,28 @@ impl Dcs {
             }),
             _ => None,
         };
+        let pairs = entries.len() + tests.len();
         let indexed = p.shape.plane.is_some()
             && (self.covered == CoveredSamples::Exact || refined.is_some())
-            && entries.len() >= INDEX_MIN_PAIRS;
+            && pairs >= INDEX_MIN_PAIRS;
         let Some(mut start) = self.pixel_start(p, f, i, s, indexed, scratch, counts) else {
             return PixelClass::Skipped;
         };
-        if let (Some(poly), false) = (&p.polygon, entries.is_empty()) {
+        if let (Some(poly), false) = (&p.polygon, pairs == 0) {
             scratch.polygon.set(poly, f.centred[i]);
         }
         // Each pair's covered-sample test. The light-overlap test decides whether the pixel
         // needs per-sample work at all: its samples are set up at the first pair that may cover
         // the light (at once when the horizon cuts the light). With the angular index the later
         // pairs go straight to their candidates, which drop off-light pairs more cheaply.
-        if start.planar && !entries.is_empty() {
+        // The scan gives the light-plane tests to exactly the pixels marked for them.
+        debug_assert!(start.planar || tests.is_empty());
+        debug_assert!(!start.planar || entries.is_empty());
+        if !tests.is_empty() {
             self.ensure_ready(p, f, i, s, &mut start, scratch);
-            Self::planar_pairs(entries, tests, indexed, scratch, counts);
+            Self::planar_pairs(tests, indexed, scratch, counts);
         }
-        let planar = start.planar;
-        for pair in entries.iter().filter(|_| !planar) {
+        for pair in entries {
             let Some(test) = p.centred_edges[pair.edge as usize].test(pc) else {
                 counts.ties += 1;
                 continue;
@@ -1003,7 +1006,6 @@ impl Dcs {
     /// candidates, appended to the pixel's updates when any.
     #[inline(never)]
     fn planar_pairs(
-        entries: &[Pair],
         tests: &[PlanarTest],
         indexed: bool,
         scratch: &mut Scratch,
@@ -1020,9 +1022,9 @@ impl Dcs {
             let index = &scratch.angular;
             let (masks, weights) = (&mut scratch.masks, &mut scratch.weights);
             let (mut empty, mut covered) = (0, 0);
-            let mut quad_of = |pairs: &[Pair], four: &[PlanarTest; 4]| {
+            let mut quad_of = |four: &[PlanarTest; 4], n: usize| {
                 let r = QuadRanges::of_tests(four);
-                for (j, (pair, test)) in pairs.iter().zip(four).enumerate() {
+                for (j, test) in four[..n].iter().enumerate() {
                     let cand = index.quad_word(&r, j) & above;
                     if cand == 0 {
                         empty += 1;
@@ -1032,30 +1034,30 @@ impl Dcs {
                     if hit != 0 {
                         covered += 1;
                         masks.push(hit);
-                        weights.push(i64::from(pair.k));
+                        weights.push(i64::from(test.k));
                     }
                 }
             };
             let (whole, rest) = tests.as_chunks::<4>();
-            for (pairs, four) in entries.chunks_exact(4).zip(whole) {
-                quad_of(pairs, four);
+            for four in whole {
+                quad_of(four, 4);
             }
             if !rest.is_empty() {
                 let mut four = [PlanarTest::NONE; 4];
                 four[..rest.len()].copy_from_slice(rest);
-                quad_of(&entries[entries.len() - rest.len()..], &four);
+                quad_of(&four, rest.len());
             }
             counts.sector_empty += empty;
             counts.covered_updates += covered;
             return;
         }
-        for (pairs, quad) in entries.chunks(4).zip(tests.chunks(4)) {
+        for quad in tests.chunks(4) {
             let ranges = indexed.then(|| {
                 let mut four = [PlanarTest::NONE; 4];
                 four[..quad.len()].copy_from_slice(quad);
                 QuadRanges::of_tests(&four)
             });
-            for (j, (pair, test)) in pairs.iter().zip(quad).enumerate() {
+            for (j, test) in quad.iter().enumerate() {
                 let mut hit = 0u64;
                 if let Some(r) = &ranges {
                     let cand = &mut scratch.batch_candidates;
@@ -1078,7 +1080,7 @@ impl Dcs {
                 if hit != 0 {
                     counts.covered_updates += 1;
                     scratch.masks.extend_from_slice(&scratch.mask);
-                    scratch.weights.push(i64::from(pair.k));
+                    scratch.weights.push(i64::from(test.k));
                 }
             }
         }
