@@ -516,7 +516,8 @@ impl Dcs {
 
     /// Per-sample visibility of pixel `i` into `scratch.visible` (with `scratch.want_values`,
     /// also `scratch.vis` and depth complexities into `scratch.depth`), and its light samples
-    /// into `scratch.samples` when the light is textured (their radiances weigh eq. 2), from its
+    /// into `scratch.samples` when the light is textured (their radiances weigh eq. 2; none for
+    /// a pixel whose integration constant alone puts it in the umbra), from its
     /// wedge pairs `entries` (and, for the light-plane test, their `tests`). Returns the class.
     #[allow(clippy::too_many_arguments)]
     fn pixel(
@@ -707,7 +708,8 @@ impl Dcs {
                 scratch.vis.resize(n, v);
                 scratch.depth.resize(n, d0);
             }
-            if textured {
+            // In the umbra every sample's weight is zero: eq. 2 needs no radiance.
+            if textured && v > 0.0 {
                 self.sampler.unit_samples(s.pixel, &mut scratch.units);
                 let light = p.light.as_ref();
                 light.sample_into(&scratch.units, &mut scratch.samples);
