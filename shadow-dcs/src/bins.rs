@@ -136,12 +136,17 @@ impl ScanWedge {
     }
 }
 
-/// Up to [`BOXES`] boxes of light-centred view samples in packed form (centres and half extents
-/// four boxes to a vector), padded by the rounding of the tests.
+/// Up to [`BOXES`] boxes of light-centred view samples in packed form (lower and upper bounds
+/// along each axis, four boxes to a vector), padded by the rounding of the tests.
+///
+/// A plane's largest value over a box is at the corner farthest along its normal: per axis the
+/// upper bound where the normal's component is not negative, else the lower one. The plane
+/// picks those bounds once for all the boxes, so a (plane, four boxes) test is three products
+/// and three sums, as a plane on four view samples is.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Boxes {
-    m: [Vec<Vec4>; 3],
-    h: [Vec<Vec4>; 3],
+    lo: [Vec<Vec4>; 3],
+    hi: [Vec<Vec4>; 3],
     /// The boxes that exist (one bit each).
     valid: u64,
 }
@@ -154,10 +159,13 @@ impl Boxes {
         for (i, b) in boxes.into_iter().enumerate() {
             assert!(i < BOXES, "at most {BOXES} boxes");
             if let Some((lo, hi)) = b {
+                // Padded around the centre by far more than the rounding of the bounds below
+                // and of a plane evaluated at a corner.
                 let m = (lo + hi) * 0.5;
                 let h = (hi - lo) * 0.5;
                 let h = h + (m.abs() + h) * BOX_PAD;
-                flat.push([m.x, m.y, m.z, h.x, h.y, h.z]);
+                let (lo, hi) = (m - h, m + h);
+                flat.push([lo.x, lo.y, lo.z, hi.x, hi.y, hi.z]);
                 self.valid |= 1 << i;
             } else {
                 flat.push([0.0; 6]);
@@ -165,7 +173,7 @@ impl Boxes {
         }
         let quads = flat.len().div_ceil(4);
         flat.resize(quads * 4, [0.0; 6]);
-        for (k, v) in self.m.iter_mut().chain(self.h.iter_mut()).enumerate() {
+        for (k, v) in self.lo.iter_mut().chain(self.hi.iter_mut()).enumerate() {
             v.clear();
             v.extend(
                 flat.chunks(4)
@@ -174,49 +182,48 @@ impl Boxes {
         }
     }
 
+    /// Per axis, the bounds at the boxes' corners farthest along `n` (the plane's largest
+    /// values) and at the nearest ones (its smallest), the first `quads` vectors of each.
+    #[inline(always)]
+    fn corners(&self, n: Vec4, quads: usize) -> ([&[Vec4]; 3], [&[Vec4]; 3]) {
+        let pick = |k: usize, c: f32| {
+            let (lo, hi) = (&self.lo[k][..quads], &self.hi[k][..quads]);
+            if c >= 0.0 { (hi, lo) } else { (lo, hi) }
+        };
+        let ((fx, nx), (fy, ny), (fz, nz)) = (pick(0, n.x), pick(1, n.y), pick(2, n.z));
+        ([fx, fy, fz], [nx, ny, nz])
+    }
+
     /// The boxes (one bit each) that may hold a view sample of wedge `w`: no bounding plane has
     /// the whole box on its negative side, and the fold planes do not both surely differ in
     /// sign over it (a NaN keeps the box). `slack` is the fold test's slack.
     #[inline]
     pub fn test(&self, w: &ScanWedge, slack: f32) -> u64 {
-        let quads = self.m[0].len().min(BOXES / 4);
-        let [m0, m1, m2] = [
-            &self.m[0][..quads],
-            &self.m[1][..quads],
-            &self.m[2][..quads],
-        ];
-        let [h0, h1, h2] = [
-            &self.h[0][..quads],
-            &self.h[1][..quads],
-            &self.h[2][..quads],
-        ];
+        let quads = self.lo[0].len().min(BOXES / 4);
+        let splat = |p: Vec4| p.to_array().map(Vec4::splat);
+        let eval =
+            |[nx, ny, nz, d]: [Vec4; 4], x: Vec4, y: Vec4, z: Vec4| nx * x + ny * y + nz * z + d;
         let mut reject = [BVec4A::splat(false); BOXES / 4];
         for p in &w.planes[..w.used as usize] {
-            let [nx, ny, nz, d] = p.to_array().map(Vec4::splat);
-            let (ax, ay, az) = (nx.abs(), ny.abs(), nz.abs());
-            for q in 0..quads {
-                let v = nx * m0[q]
-                    + ny * m1[q]
-                    + nz * m2[q]
-                    + d
-                    + (ax * h0[q] + ay * h1[q] + az * h2[q]);
-                reject[q] |= v.cmplt(Vec4::ZERO);
+            let ([x, y, z], _) = self.corners(*p, quads);
+            let n = splat(*p);
+            for (r, ((x, y), z)) in reject[..quads].iter_mut().zip(x.iter().zip(y).zip(z)) {
+                *r |= eval(n, *x, *y, *z).cmplt(Vec4::ZERO);
             }
         }
-        let [f1, f2] = w.fold.map(|p| {
-            let [nx, ny, nz, d] = p.to_array().map(Vec4::splat);
-            [nx, ny, nz, d, nx.abs(), ny.abs(), nz.abs()]
-        });
+        let [f1, f2] = w.fold;
+        let ((far1, near1), (far2, near2)) = (self.corners(f1, quads), self.corners(f2, quads));
+        let (n1, n2) = (splat(f1), splat(f2));
+        let at = |c: &[&[Vec4]; 3], q: usize| (c[0][q], c[1][q], c[2][q]);
         let s = Vec4::splat(slack);
         let mut mask = 0u64;
-        for q in 0..quads {
-            let centre = |p: &[Vec4; 7]| p[0] * m0[q] + p[1] * m1[q] + p[2] * m2[q] + p[3];
-            let radius = |p: &[Vec4; 7]| p[4] * h0[q] + p[5] * h1[q] + p[6] * h2[q];
-            let (c1, r1, c2, r2) = (centre(&f1), radius(&f1), centre(&f2), radius(&f2));
+        for (q, r) in reject[..quads].iter().enumerate() {
+            let ((a, b, c), (d, e, f)) = (at(&far1, q), at(&far2, q));
+            let ((g, h, i), (j, k, l)) = (at(&near1, q), at(&near2, q));
             // Surely no silhouette: the fold planes surely differ in sign over the whole box.
-            let not_both_positive = (c1 + r1).cmple(-s) | (c2 + r2).cmple(-s);
-            let not_both_negative = (c1 - r1).cmpge(s) | (c2 - r2).cmpge(s);
-            let out = reject[q] | (not_both_positive & not_both_negative);
+            let not_both_positive = eval(n1, a, b, c).cmple(-s) | eval(n2, d, e, f).cmple(-s);
+            let not_both_negative = eval(n1, g, h, i).cmpge(s) | eval(n2, j, k, l).cmpge(s);
+            let out = *r | (not_both_positive & not_both_negative);
             mask |= u64::from(!out.bitmask() & 0xf) << (4 * q);
         }
         mask & self.valid
