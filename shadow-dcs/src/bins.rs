@@ -17,9 +17,10 @@
 //! A box keeps a wedge when none of the wedge's bounding planes ([`crate::wedges::wedge_planes`])
 //! has the whole box on its negative side, and the edge may be a silhouette from some point of
 //! the box (its two face planes, with a slack). A test loads one wedge's planes and evaluates
-//! them on the boxes four at a time, centres and half extents in packed vectors. Boxes are
-//! padded by their own rounding, so that no test rejects a view sample that the exact test on
-//! the lanes would keep.
+//! each at the boxes' corners farthest along its normal (and, for the face planes, the nearest
+//! ones too), four boxes at a time, the bounds in packed vectors. Boxes are padded by their own
+//! rounding, so that no test rejects a view sample that the exact test on the lanes would
+//! keep.
 
 use glam::{BVec4A, DVec3, Vec3, Vec4};
 use rayon::prelude::*;
@@ -505,10 +506,10 @@ impl SquareTiles {
 }
 
 /// The pairs of wedge `wi` with the view samples of a tile (`tile`, `quads`, its first view
-/// sample at column and row `origin`): the weight first (it rejects more view samples than the
-/// planes), exact where the single-precision signs are uncertain, then the bounding planes on
-/// the view samples left. Calls `pair(lane, image index, k)` for each view sample with a
-/// non-zero weight, in lane order.
+/// sample at column and row `origin`): the fold planes (where the edge may be a silhouette),
+/// then the bounding planes on the view samples left, then the weights where any is inside,
+/// exact where the single-precision signs are uncertain. Calls `pair(lane, image index, k)` for
+/// each view sample with a non-zero weight, in lane order.
 #[inline]
 pub(crate) fn tile_pairs(
     input: &ScanInput,
@@ -527,12 +528,14 @@ pub(crate) fn tile_pairs(
     if fold == 0 {
         return;
     }
+    // Where the edge may be a silhouette its weight is rarely zero (on `bunny`, at no view
+    // sample the fold test keeps), so the planes come first and the weights are taken only
+    // for tiles with a view sample inside.
+    let inside = wedge.inside(quads, fold);
+    if inside == 0 {
+        return;
+    }
     let fast = wedge.weight.as_ref().and_then(|f| f.weight_lanes(quads));
-    let candidates = match &fast {
-        Some(f) => fold & (f.nonzero | !f.certain),
-        None => fold,
-    };
-    let inside = wedge.inside(quads, candidates);
     let w = input.width as usize;
     for j in lanes_of(inside) {
         let i =
@@ -605,9 +608,9 @@ pub(crate) struct ScanInput<'a> {
 
 /// The pairs of square `rect` from the wedges its box keeps (`wedges`, silhouette indices in
 /// order): every wedge against the boxes of the square's tiles, then tile by tile, each of its
-/// wedges on the tile's view samples (weight first, exact where the single-precision signs are
-/// uncertain, then the bounding planes), with the light-plane test set up while the wedge is
-/// at hand.
+/// wedges on the tile's view samples (fold planes, bounding planes, then the weight, exact
+/// where the single-precision signs are uncertain), with the light-plane test set up while the
+/// wedge is at hand.
 pub(crate) fn square_pairs(
     input: &ScanInput,
     wedges: &[u32],

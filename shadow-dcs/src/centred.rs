@@ -134,12 +134,11 @@ impl FastWeight {
 }
 
 /// `k_e` at every lane of a tile, with the mask of lanes whose signs are all certain (lanes
-/// outside it must take the exact weight) and the mask of lanes where it is not zero. Face
+/// outside it must take the exact weight). Face
 /// weights are at most [`LANE_WEIGHT_MAX`], so that a lane's sum is exact in single precision.
 pub(crate) struct LaneWeights {
     k: [f32; LANES],
     pub certain: LaneMask,
-    pub nonzero: LaneMask,
 }
 
 impl LaneWeights {
@@ -153,16 +152,6 @@ impl LaneWeights {
 /// The largest face weight the lane form takes (larger ones go through the exact weight): two
 /// of them add up exactly in single precision.
 const LANE_WEIGHT_MAX: i64 = 1 << 22;
-
-/// The mask of lanes where a lane quad comparison holds.
-#[inline(always)]
-fn mask_of(v: &[glam::BVec4A; QUADS]) -> LaneMask {
-    let mut m = 0;
-    for (q, b) in v.iter().enumerate() {
-        m |= (b.bitmask() as LaneMask) << (4 * q);
-    }
-    m
-}
 
 impl FastWeight {
     /// `k_e` at every lane of a tile by the rule of [`SceneEdge::sweep_weight`] from a view
@@ -201,16 +190,11 @@ impl FastWeight {
                 };
             }
         }
-        let nonzero = mask_of(&k.map(|x| x.cmpne(zero)));
         let mut out = [0.0f32; LANES];
         for q in 0..QUADS {
             out[4 * q..4 * q + 4].copy_from_slice(&k[q].to_array());
         }
-        Some(LaneWeights {
-            k: out,
-            certain,
-            nonzero,
-        })
+        Some(LaneWeights { k: out, certain })
     }
 }
 
