@@ -219,6 +219,11 @@ impl Boxes {
         let s = Vec4::splat(slack);
         let mut mask = 0u64;
         for (q, r) in reject[..quads].iter().enumerate() {
+            // Four boxes the planes reject (most of them: a wedge meets few of a grid's
+            // cells) need no fold test.
+            if r.all() {
+                continue;
+            }
             let ((a, b, c), (d, e, f)) = (at(&far1, q), at(&far2, q));
             let ((g, h, i), (j, k, l)) = (at(&near1, q), at(&near2, q));
             // Surely no silhouette: the fold planes surely differ in sign over the whole box.
