@@ -196,15 +196,39 @@ impl Boxes {
         ([fx, fy, fz], [nx, ny, nz])
     }
 
+    /// [`Boxes::test`] on the quads of boxes in `quads` (one bit per quad) alone; the other
+    /// boxes are not kept.
+    pub fn test_quads(&self, w: &ScanWedge, slack: f32, quads: u64) -> u64 {
+        let n = self.lo[0].len().min(BOXES / 4);
+        let mut live = [0usize; BOXES / 4];
+        let mut count = 0;
+        for q in bits_of(quads & ((1 << n) - 1)) {
+            live[count] = q;
+            count += 1;
+        }
+        let live = &live[..count];
+        let mut reject = [BVec4A::splat(false); BOXES / 4];
+        for p in &w.planes[..w.used as usize] {
+            let ([x, y, z], _) = self.corners(*p, n);
+            let s = splat(*p);
+            for (r, &q) in reject.iter_mut().zip(live) {
+                *r |= eval(s, x[q], y[q], z[q]).cmplt(Vec4::ZERO);
+            }
+        }
+        let fold = FoldTest::new(self, w, slack, n);
+        let mut mask = 0u64;
+        for (r, &q) in reject.iter().zip(live) {
+            mask |= fold.kept(*r, q) << (4 * q);
+        }
+        mask & self.valid
+    }
+
     /// The boxes (one bit each) that may hold a view sample of wedge `w`: no bounding plane has
     /// the whole box on its negative side, and the fold planes do not both surely differ in
     /// sign over it (a NaN keeps the box). `slack` is the fold test's slack.
     #[inline]
     pub fn test(&self, w: &ScanWedge, slack: f32) -> u64 {
         let quads = self.lo[0].len().min(BOXES / 4);
-        let splat = |p: Vec4| p.to_array().map(Vec4::splat);
-        let eval =
-            |[nx, ny, nz, d]: [Vec4; 4], x: Vec4, y: Vec4, z: Vec4| nx * x + ny * y + nz * z + d;
         let mut reject = [BVec4A::splat(false); BOXES / 4];
         for p in &w.planes[..w.used as usize] {
             let ([x, y, z], _) = self.corners(*p, quads);
@@ -213,27 +237,64 @@ impl Boxes {
                 *r |= eval(n, *x, *y, *z).cmplt(Vec4::ZERO);
             }
         }
-        let [f1, f2] = w.fold;
-        let ((far1, near1), (far2, near2)) = (self.corners(f1, quads), self.corners(f2, quads));
-        let (n1, n2) = (splat(f1), splat(f2));
-        let at = |c: &[&[Vec4]; 3], q: usize| (c[0][q], c[1][q], c[2][q]);
-        let s = Vec4::splat(slack);
+        let fold = FoldTest::new(self, w, slack, quads);
         let mut mask = 0u64;
         for (q, r) in reject[..quads].iter().enumerate() {
-            // Four boxes the planes reject (most of them: a wedge meets few of a grid's
-            // cells) need no fold test.
-            if r.all() {
-                continue;
-            }
-            let ((a, b, c), (d, e, f)) = (at(&far1, q), at(&far2, q));
-            let ((g, h, i), (j, k, l)) = (at(&near1, q), at(&near2, q));
-            // Surely no silhouette: the fold planes surely differ in sign over the whole box.
-            let not_both_positive = eval(n1, a, b, c).cmple(-s) | eval(n2, d, e, f).cmple(-s);
-            let not_both_negative = eval(n1, g, h, i).cmpge(s) | eval(n2, j, k, l).cmpge(s);
-            let out = *r | (not_both_positive & not_both_negative);
-            mask |= u64::from(!out.bitmask() & 0xf) << (4 * q);
+            mask |= fold.kept(*r, q) << (4 * q);
         }
         mask & self.valid
+    }
+}
+
+/// A plane's four coefficients, each in all lanes.
+#[inline(always)]
+fn splat(p: Vec4) -> [Vec4; 4] {
+    p.to_array().map(Vec4::splat)
+}
+
+/// The plane `[nx, ny, nz, d]` (splatted) at the points `(x, y, z)`, four at a time.
+#[inline(always)]
+fn eval([nx, ny, nz, d]: [Vec4; 4], x: Vec4, y: Vec4, z: Vec4) -> Vec4 {
+    nx * x + ny * y + nz * z + d
+}
+
+/// The fold part of a box test: a wedge's two face planes at the boxes' farthest and nearest
+/// corners.
+struct FoldTest<'a> {
+    planes: [[Vec4; 4]; 2],
+    far: [[&'a [Vec4]; 3]; 2],
+    near: [[&'a [Vec4]; 3]; 2],
+    slack: Vec4,
+}
+
+impl<'a> FoldTest<'a> {
+    #[inline(always)]
+    fn new(boxes: &'a Boxes, w: &ScanWedge, slack: f32, quads: usize) -> Self {
+        let [f1, f2] = w.fold;
+        let ((far1, near1), (far2, near2)) = (boxes.corners(f1, quads), boxes.corners(f2, quads));
+        Self {
+            planes: [splat(f1), splat(f2)],
+            far: [far1, far2],
+            near: [near1, near2],
+            slack: Vec4::splat(slack),
+        }
+    }
+
+    /// The boxes of quad `q` kept (one bit each), given the bounding planes' rejections.
+    #[inline(always)]
+    fn kept(&self, reject: BVec4A, q: usize) -> u64 {
+        // Four boxes the planes reject (most of them: a wedge meets few of a grid's cells)
+        // need no fold test.
+        if reject.all() {
+            return 0;
+        }
+        let value = |k: usize, c: &[&[Vec4]; 3]| eval(self.planes[k], c[0][q], c[1][q], c[2][q]);
+        let s = self.slack;
+        // Surely no silhouette: the fold planes surely differ in sign over the whole box.
+        let not_both_positive = value(0, &self.far[0]).cmple(-s) | value(1, &self.far[1]).cmple(-s);
+        let not_both_negative = value(0, &self.near[0]).cmpge(s) | value(1, &self.near[1]).cmpge(s);
+        let out = reject | (not_both_positive & not_both_negative);
+        u64::from(!out.bitmask() & 0xf)
     }
 }
 
@@ -327,8 +388,9 @@ impl BlockWedges {
     }
 
     /// The second level for block `block` (with squares `squares`): the wedges its box keeps
-    /// against its squares' boxes. Returns each square's wedges (silhouette indices in order)
-    /// and the number of wedges the block kept.
+    /// against the boxes of its clusters of [`CLUSTER`] x [`CLUSTER`] pixels, then those a
+    /// cluster keeps against its squares' boxes. Returns each square's wedges (silhouette
+    /// indices in order) and the number of wedges the block kept.
     pub fn square_lists(
         &self,
         input: &ScanInput,
@@ -336,12 +398,7 @@ impl BlockWedges {
         squares: &[Rect],
     ) -> (Vec<Vec<u32>>, usize) {
         let (g, bit) = (block / BOXES, block % BOXES);
-        let mut sq = Boxes::default();
-        sq.set(
-            squares
-                .iter()
-                .map(|r| rect_box(*r, input.width, input.centred, input.active)),
-        );
+        let clusters = Clusters::new(input, squares);
         let mut lists: Vec<Vec<u32>> = vec![Vec::new(); squares.len()];
         let mut kept = 0;
         for wi in 0..input.wedges.len() {
@@ -349,11 +406,74 @@ impl BlockWedges {
                 continue;
             }
             kept += 1;
-            for s in bits_of(sq.test(&input.wedges[wi], input.slack)) {
-                lists[s].push(wi as u32);
+            let w = &input.wedges[wi];
+            let live = clusters.boxes.test(w, input.slack);
+            if live == 0 {
+                continue;
+            }
+            for slot in bits_of(clusters.squares.test_quads(w, input.slack, live)) {
+                lists[clusters.slots[slot]].push(wi as u32);
             }
         }
         (lists, kept)
+    }
+}
+
+/// Side of a cluster of squares, in pixels: the level between blocks and squares.
+const CLUSTER: u32 = 2 * SQUARE;
+
+/// A block's squares grouped by clusters of [`CLUSTER`] x [`CLUSTER`] pixels: a wedge a block
+/// keeps meets few of its squares, so the clusters are tested first and then only the squares
+/// of the clusters kept, each cluster's (at most four) squares one quad of the square boxes.
+struct Clusters {
+    /// The clusters' boxes.
+    boxes: Boxes,
+    /// The squares' boxes, cluster by cluster, four slots per cluster.
+    squares: Boxes,
+    /// The square (index into the block's squares) of each slot; unused slots have no box.
+    slots: Vec<usize>,
+}
+
+impl Clusters {
+    fn new(input: &ScanInput, squares: &[Rect]) -> Self {
+        let Some(first) = squares.first() else {
+            return Self {
+                boxes: Boxes::default(),
+                squares: Boxes::default(),
+                slots: Vec::new(),
+            };
+        };
+        let (x0, y0) = (first.cols.0, first.rows.0);
+        let right = squares.iter().map(|r| r.cols.1).max().unwrap_or(x0);
+        let across = (right - x0) / CLUSTER + 1;
+        let mut slots = Vec::new();
+        for (s, r) in squares.iter().enumerate() {
+            let (cx, cy) = ((r.cols.0 - x0) / CLUSTER, (r.rows.0 - y0) / CLUSTER);
+            let (sx, sy) = ((r.cols.0 - x0) / SQUARE % 2, (r.rows.0 - y0) / SQUARE % 2);
+            let slot = ((cy * across + cx) * 4 + sy * 2 + sx) as usize;
+            if slots.len() <= slot {
+                slots.resize(slot + 1, usize::MAX);
+            }
+            slots[slot] = s;
+        }
+        slots.resize(slots.len().next_multiple_of(4), usize::MAX);
+        let square_box = |slot: &usize| {
+            let r = squares.get(*slot)?;
+            rect_box(*r, input.width, input.centred, input.active)
+        };
+        let mut boxes = Boxes::default();
+        boxes.set(slots.chunks(4).map(|c| {
+            c.iter()
+                .filter_map(square_box)
+                .reduce(|(lo, hi), (l, h)| (lo.min(l), hi.max(h)))
+        }));
+        let mut sq = Boxes::default();
+        sq.set(slots.iter().map(square_box));
+        Self {
+            boxes,
+            squares: sq,
+            slots,
+        }
     }
 }
 
