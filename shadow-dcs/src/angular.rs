@@ -62,6 +62,32 @@ fn bucket(a: f32) -> usize {
     ((a * (BUCKETS as f32 / TURN)) as i32).clamp(0, BUCKETS as i32 - 1) as usize
 }
 
+/// [`direction_angle`] of four directions at once (the same operations lane by lane).
+#[inline(always)]
+fn direction_angles(x: Vec4, y: Vec4) -> Vec4 {
+    let zero = Vec4::ZERO;
+    let t = x / (x.abs() + y.abs());
+    let a = Vec4::select(y.cmpge(zero), Vec4::ONE - t, Vec4::splat(3.0) + t);
+    // Zero vector (NaN) and the rounding to 4 just below +x both map to 0.
+    Vec4::select(a.cmpge(zero) & a.cmplt(Vec4::splat(TURN)), a, zero)
+}
+
+/// [`bucket`] of four pseudo-angles, without a saturating conversion per lane: the scaled
+/// values are clamped to the buckets' range in the vector (`max` with 0 first, which also
+/// takes a NaN to 0) and floored there, and a whole number below `2^23` plus `2^23` holds
+/// itself in its low mantissa bits.
+#[inline(always)]
+fn buckets(a: Vec4) -> [usize; 4] {
+    const WHOLE: f32 = 8_388_608.0;
+    let last = (BUCKETS - 1) as f32;
+    let b = (a * (BUCKETS as f32 / TURN))
+        .max(Vec4::ZERO)
+        .min(Vec4::splat(last))
+        .floor()
+        + Vec4::splat(WHOLE);
+    b.to_array().map(|x| (x.to_bits() & 0x7f_ffff) as usize)
+}
+
 impl AngularIndex {
     /// Indexes the sample `positions` of a pixel on the light `plane` with centre `c`.
     pub fn build(&mut self, plane: &LightPlane, c: Vec3, positions: &[Vec3]) {
@@ -81,10 +107,17 @@ impl AngularIndex {
     /// `samples`).
     pub fn build_planar(&mut self, samples: &PlanarSamples, n: usize) {
         self.buckets.clear();
+        // Four samples at a time, the rest one by one (the same values).
+        let (xs, x_rest) = samples.x[..n].as_chunks::<4>();
+        let (ys, y_rest) = samples.y[..n].as_chunks::<4>();
+        for (x, y) in xs.iter().zip(ys) {
+            let a = direction_angles(Vec4::from(*x), Vec4::from(*y));
+            self.buckets.extend(buckets(a).map(|b| b as u32));
+        }
         self.buckets.extend(
-            samples.x[..n]
+            x_rest
                 .iter()
-                .zip(&samples.y[..n])
+                .zip(y_rest)
                 .map(|(x, y)| bucket(direction_angle(*x, *y)) as u32),
         );
         self.index_buckets(n);
@@ -277,12 +310,7 @@ impl QuadRanges {
     fn of(ax: Vec4, ay: Vec4, bx: Vec4, by: Vec4) -> Self {
         let zero = Vec4::ZERO;
         let turn = Vec4::splat(TURN);
-        let angle = |x: Vec4, y: Vec4| -> Vec4 {
-            let t = x / (x.abs() + y.abs());
-            let a = Vec4::select(y.cmpge(zero), Vec4::ONE - t, Vec4::splat(3.0) + t);
-            // Zero vector (NaN) and the rounding to 4 just below +x both map to 0.
-            Vec4::select(a.cmpge(zero) & a.cmplt(turn), a, zero)
-        };
+        let angle = direction_angles;
         let la2 = ax * ax + ay * ay;
         let lb2 = bx * bx + by * by;
         let cross = ax * by - ay * bx;
@@ -303,15 +331,9 @@ impl QuadRanges {
             & lb2.cmpgt(zero)
             & (cross * cross).cmpgt(Vec4::splat(1e-6) * la2 * lb2)
             & len.cmplt(Vec4::splat(TURN / 2.0));
-        let scale = Vec4::splat(BUCKETS as f32 / TURN);
-        let to_bucket = |a: Vec4| -> [usize; 4] {
-            (a * scale)
-                .to_array()
-                .map(|x| (x as i32).clamp(0, BUCKETS as i32 - 1) as usize)
-        };
         Self {
-            lo: to_bucket(lo),
-            hi: to_bucket(hi),
+            lo: buckets(lo),
+            hi: buckets(hi),
             narrow: narrow.bitmask(),
             wraps: lo.cmpgt(hi).bitmask(),
         }
@@ -451,6 +473,65 @@ mod tests {
     use shadow_core::light::AreaLight;
     use shadow_core::light::{Radiance, RectLight};
     use shadow_core::sampling::{LightSampler, SamplingStrategy, hash_words, unit_float};
+
+    /// Four directions' pseudo-angles and buckets at once equal those one by one, at the
+    /// axes, at the zero vector, at NaN and infinities, and at pseudo-angles on either side of
+    /// every bucket's border.
+    #[test]
+    fn four_buckets_at_once_equal_one_by_one() {
+        let mut dirs: Vec<(f32, f32)> = vec![
+            (1.0, 0.0),
+            (0.0, 1.0),
+            (-1.0, 0.0),
+            (0.0, -1.0),
+            (0.0, 0.0),
+            (-0.0, -0.0),
+            (1.0, -1e-30),
+            (f32::NAN, 1.0),
+            (f32::INFINITY, 1.0),
+            (3.0, f32::NEG_INFINITY),
+        ];
+        dirs.extend((0..4000u64).map(|k| {
+            let r = |i: u64| unit_float(hash_words(&[k, i])) * 2.0 - 1.0;
+            (r(0), r(1) * 10f32.powi((k % 7) as i32 - 3))
+        }));
+        for q in dirs.chunks(4) {
+            let mut four = [(0.0f32, 0.0f32); 4];
+            four[..q.len()].copy_from_slice(q);
+            let (x, y) = (four.map(|d| d.0), four.map(|d| d.1));
+            let a = direction_angles(Vec4::from(x), Vec4::from(y));
+            for j in 0..4 {
+                let one = direction_angle(x[j], y[j]);
+                assert_eq!(a[j].to_bits(), one.to_bits(), "{:?}", four[j]);
+                assert_eq!(buckets(a)[j], bucket(one), "{:?}", four[j]);
+            }
+        }
+        // Pseudo-angles around every border, below 0, at and above a whole turn, NaN.
+        let step = TURN / BUCKETS as f32;
+        let mut angles: Vec<f32> = (0..=BUCKETS)
+            .flat_map(|b| {
+                let a = b as f32 * step;
+                [a.next_down(), a, a.next_up()]
+            })
+            .collect();
+        angles.extend([
+            -1.0,
+            -0.0,
+            4.0,
+            1e30,
+            f32::NAN,
+            f32::INFINITY,
+            -f32::INFINITY,
+        ]);
+        for q in angles.chunks(4) {
+            let mut four = [0.0f32; 4];
+            four[..q.len()].copy_from_slice(q);
+            let b = buckets(Vec4::from(four));
+            for j in 0..4 {
+                assert_eq!(b[j], bucket(four[j]), "{}", four[j]);
+            }
+        }
+    }
 
     /// The candidates hold every sample the exact test covers, and leave most uncovered
     /// samples out.
