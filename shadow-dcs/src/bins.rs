@@ -147,8 +147,12 @@ impl ScanWedge {
 /// and three sums, as a plane on four view samples is.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Boxes {
-    lo: [Vec<Vec4>; 3],
-    hi: [Vec<Vec4>; 3],
+    /// Per axis, the lower bounds, four boxes to a vector (fixed arrays: a plane's pick of
+    /// bounds is then one pointer per axis, and indices below [`Boxes::quads`] need no check).
+    lo: [[Vec4; BOXES / 4]; 3],
+    hi: [[Vec4; BOXES / 4]; 3],
+    /// Vectors in use.
+    quads: usize,
     /// The boxes that exist (one bit each).
     valid: u64,
 }
@@ -156,10 +160,18 @@ pub(crate) struct Boxes {
 impl Boxes {
     /// Sets the boxes (`None`: a box without view samples, which no test keeps).
     pub fn set(&mut self, boxes: impl IntoIterator<Item = Option<(Vec3, Vec3)>>) {
-        let mut flat: Vec<[f32; 6]> = Vec::with_capacity(BOXES);
         self.valid = 0;
+        self.quads = 0;
         for (i, b) in boxes.into_iter().enumerate() {
             assert!(i < BOXES, "at most {BOXES} boxes");
+            let (q, lane) = (i / 4, i % 4);
+            if lane == 0 {
+                // A new vector of four boxes, none yet.
+                for v in self.lo.iter_mut().chain(self.hi.iter_mut()) {
+                    v[q] = Vec4::ZERO;
+                }
+                self.quads = q + 1;
+            }
             if let Some((lo, hi)) = b {
                 // Padded around the centre by far more than the rounding of the bounds below
                 // and of a plane evaluated at a corner.
@@ -167,29 +179,21 @@ impl Boxes {
                 let h = (hi - lo) * 0.5;
                 let h = h + (m.abs() + h) * BOX_PAD;
                 let (lo, hi) = (m - h, m + h);
-                flat.push([lo.x, lo.y, lo.z, hi.x, hi.y, hi.z]);
+                for k in 0..3 {
+                    self.lo[k][q][lane] = lo[k];
+                    self.hi[k][q][lane] = hi[k];
+                }
                 self.valid |= 1 << i;
-            } else {
-                flat.push([0.0; 6]);
             }
-        }
-        let quads = flat.len().div_ceil(4);
-        flat.resize(quads * 4, [0.0; 6]);
-        for (k, v) in self.lo.iter_mut().chain(self.hi.iter_mut()).enumerate() {
-            v.clear();
-            v.extend(
-                flat.chunks(4)
-                    .map(|q| Vec4::new(q[0][k], q[1][k], q[2][k], q[3][k])),
-            );
         }
     }
 
     /// Per axis, the bounds at the boxes' corners farthest along `n` (the plane's largest
-    /// values) and at the nearest ones (its smallest), the first `quads` vectors of each.
+    /// values) and at the nearest ones (its smallest).
     #[inline(always)]
-    fn corners(&self, n: Vec4, quads: usize) -> ([&[Vec4]; 3], [&[Vec4]; 3]) {
+    fn corners(&self, n: Vec4) -> Corners<'_> {
         let pick = |k: usize, c: f32| {
-            let (lo, hi) = (&self.lo[k][..quads], &self.hi[k][..quads]);
+            let (lo, hi) = (&self.lo[k], &self.hi[k]);
             if c >= 0.0 { (hi, lo) } else { (lo, hi) }
         };
         let ((fx, nx), (fy, ny), (fz, nz)) = (pick(0, n.x), pick(1, n.y), pick(2, n.z));
@@ -199,7 +203,7 @@ impl Boxes {
     /// [`Boxes::test`] on the quads of boxes in `quads` (one bit per quad) alone; the other
     /// boxes are not kept.
     pub fn test_quads(&self, w: &ScanWedge, slack: f32, quads: u64) -> u64 {
-        let n = self.lo[0].len().min(BOXES / 4);
+        let n = self.quads.min(BOXES / 4);
         let mut live = [0usize; BOXES / 4];
         let mut count = 0;
         for q in bits_of(quads & ((1 << n) - 1)) {
@@ -209,13 +213,13 @@ impl Boxes {
         let live = &live[..count];
         let mut reject = [BVec4A::splat(false); BOXES / 4];
         for p in &w.planes[..w.used as usize] {
-            let ([x, y, z], _) = self.corners(*p, n);
+            let ([x, y, z], _) = self.corners(*p);
             let s = splat(*p);
             for (r, &q) in reject.iter_mut().zip(live) {
                 *r |= eval(s, x[q], y[q], z[q]).cmplt(Vec4::ZERO);
             }
         }
-        let fold = FoldTest::new(self, w, slack, n);
+        let fold = FoldTest::new(self, w, slack);
         let mut mask = 0u64;
         for (r, &q) in reject.iter().zip(live) {
             mask |= fold.kept(*r, q) << (4 * q);
@@ -228,16 +232,16 @@ impl Boxes {
     /// sign over it (a NaN keeps the box). `slack` is the fold test's slack.
     #[inline]
     pub fn test(&self, w: &ScanWedge, slack: f32) -> u64 {
-        let quads = self.lo[0].len().min(BOXES / 4);
+        let quads = self.quads.min(BOXES / 4);
         let mut reject = [BVec4A::splat(false); BOXES / 4];
         for p in &w.planes[..w.used as usize] {
-            let ([x, y, z], _) = self.corners(*p, quads);
+            let ([x, y, z], _) = self.corners(*p);
             let n = splat(*p);
-            for (r, ((x, y), z)) in reject[..quads].iter_mut().zip(x.iter().zip(y).zip(z)) {
-                *r |= eval(n, *x, *y, *z).cmplt(Vec4::ZERO);
+            for q in 0..quads {
+                reject[q] |= eval(n, x[q], y[q], z[q]).cmplt(Vec4::ZERO);
             }
         }
-        let fold = FoldTest::new(self, w, slack, quads);
+        let fold = FoldTest::new(self, w, slack);
         let mut mask = 0u64;
         for (q, r) in reject[..quads].iter().enumerate() {
             mask |= fold.kept(*r, q) << (4 * q);
@@ -245,6 +249,9 @@ impl Boxes {
         mask & self.valid
     }
 }
+
+/// Per axis, one bound array of a [`Boxes`] for the farthest corners, then for the nearest.
+type Corners<'a> = ([&'a [Vec4; BOXES / 4]; 3], [&'a [Vec4; BOXES / 4]; 3]);
 
 /// A plane's four coefficients, each in all lanes.
 #[inline(always)]
@@ -262,16 +269,16 @@ fn eval([nx, ny, nz, d]: [Vec4; 4], x: Vec4, y: Vec4, z: Vec4) -> Vec4 {
 /// corners.
 struct FoldTest<'a> {
     planes: [[Vec4; 4]; 2],
-    far: [[&'a [Vec4]; 3]; 2],
-    near: [[&'a [Vec4]; 3]; 2],
+    far: [[&'a [Vec4; BOXES / 4]; 3]; 2],
+    near: [[&'a [Vec4; BOXES / 4]; 3]; 2],
     slack: Vec4,
 }
 
 impl<'a> FoldTest<'a> {
     #[inline(always)]
-    fn new(boxes: &'a Boxes, w: &ScanWedge, slack: f32, quads: usize) -> Self {
+    fn new(boxes: &'a Boxes, w: &ScanWedge, slack: f32) -> Self {
         let [f1, f2] = w.fold;
-        let ((far1, near1), (far2, near2)) = (boxes.corners(f1, quads), boxes.corners(f2, quads));
+        let ((far1, near1), (far2, near2)) = (boxes.corners(f1), boxes.corners(f2));
         Self {
             planes: [splat(f1), splat(f2)],
             far: [far1, far2],
@@ -288,7 +295,8 @@ impl<'a> FoldTest<'a> {
         if reject.all() {
             return 0;
         }
-        let value = |k: usize, c: &[&[Vec4]; 3]| eval(self.planes[k], c[0][q], c[1][q], c[2][q]);
+        let value =
+            |k: usize, c: &[&[Vec4; BOXES / 4]; 3]| eval(self.planes[k], c[0][q], c[1][q], c[2][q]);
         let s = self.slack;
         // Surely no silhouette: the fold planes surely differ in sign over the whole box.
         let not_both_positive = value(0, &self.far[0]).cmple(-s) | value(1, &self.far[1]).cmple(-s);
