@@ -639,8 +639,8 @@ impl SquareTiles {
     }
 }
 
-/// The pairs of wedge `wi` with the view samples of a tile (`tile`, `quads`, its first view
-/// sample at column and row `origin`): the fold planes (where the edge may be a silhouette),
+/// The pairs of wedge `wi` with the view samples of a tile (`tile`, `quads`, the image index
+/// of each lane in `pixels`): the fold planes (where the edge may be a silhouette),
 /// then the bounding planes on the view samples left, then the weights where any is inside,
 /// exact where the single-precision signs are uncertain. Calls `pair(lane, image index, k)` for
 /// each view sample with a non-zero weight, in lane order.
@@ -650,7 +650,7 @@ pub(crate) fn tile_pairs(
     wi: u32,
     tile: &TileLanes,
     quads: &TileQuads,
-    origin: (u32, u32),
+    pixels: &[usize; LANES],
     counts: &mut ScanCounts,
     mut pair: impl FnMut(usize, usize, i32),
 ) {
@@ -670,10 +670,8 @@ pub(crate) fn tile_pairs(
         return;
     }
     let fast = wedge.weight.as_ref().and_then(|f| f.weight_lanes(quads));
-    let w = input.width as usize;
     for j in lanes_of(inside) {
-        let i =
-            (origin.1 + j as u32 / TILE_W) as usize * w + (origin.0 + j as u32 % TILE_W) as usize;
+        let i = pixels[j];
         let k = match &fast {
             Some(f) if f.certain >> j & 1 == 1 => f.k(j),
             _ => {
@@ -760,9 +758,14 @@ pub(crate) fn square_pairs(
     out.reset(tiles.lanes.len() * LANES);
     let mut ties = 0;
     let mut len = 0;
+    // Each lane's image index from its tile's first.
+    let w = input.width as usize;
+    let offsets: [usize; LANES] =
+        std::array::from_fn(|j| j / TILE_W as usize * w + j % TILE_W as usize);
     for (t, (tile, list)) in tiles.lanes.iter().zip(tiles.lists.iter()).enumerate() {
         let quads = tile.quads();
-        let origin = tiles.origin(t);
+        let (x, y) = tiles.origin(t);
+        let pixels = offsets.map(|o| y as usize * w + x as usize + o);
         out.counts.scanned += u64::from(tile.active.count_ones()) * list.len() as u64;
         let entries = &mut out.entries[t * LANES..(t + 1) * LANES];
         let tests = &mut out.tests[t * LANES..(t + 1) * LANES];
@@ -772,7 +775,7 @@ pub(crate) fn square_pairs(
                 wi,
                 tile,
                 &quads,
-                origin,
+                &pixels,
                 &mut out.counts,
                 |j, i, k| {
                     match planar_test(input, wi, i, tile.l1[j]) {

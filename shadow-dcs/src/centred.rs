@@ -145,13 +145,17 @@ impl LaneWeights {
     /// `k_e` at lane `j`.
     #[inline]
     pub fn k(&self, j: usize) -> i64 {
-        self.k[j] as i64
+        // A whole number of magnitude below `2^22` plus `1.5 * 2^23` keeps itself in the low
+        // bits (no saturating conversion): the face weights are at most `2^20`.
+        const MAGIC: f32 = 12_582_912.0;
+        i64::from((self.k[j] + MAGIC).to_bits() as i32 - MAGIC.to_bits() as i32)
     }
 }
 
 /// The largest face weight the lane form takes (larger ones go through the exact weight): two
-/// of them add up exactly in single precision.
-const LANE_WEIGHT_MAX: i64 = 1 << 22;
+/// of them add up exactly in single precision, and their sum converts through
+/// [`LaneWeights::k`]'s bits.
+const LANE_WEIGHT_MAX: i64 = 1 << 20;
 
 impl FastWeight {
     /// `k_e` at every lane of a tile by the rule of [`SceneEdge::sweep_weight`] from a view
@@ -280,6 +284,12 @@ mod tests {
         }
     }
 
+    /// Face weights for case `k`: one, a semi-opaque occluder's units, the lane form's largest.
+    fn weights(k: u64) -> [u32; 2] {
+        let w = [1, 1, 255, LANE_WEIGHT_MAX as u32];
+        [w[(k % 4) as usize], w[(k / 4 % 4) as usize]]
+    }
+
     /// Case `k`: a light centre and below it an edge with two faces (their orientations
     /// flipped by `flips`), everything moved by `offset` along the diagonal.
     fn random_edge(
@@ -314,7 +324,10 @@ mod tests {
         let (mut certain, mut total) = (0, 0);
         for k in 0..400u64 {
             let r = |i: u64| unit_float(hash_words(&[k, i])) as f64 * 2.0 - 1.0;
-            let (c, edge) = random_edge(k, 0.0, (k % 2 == 0, k % 4 < 2), k % 3 == 0);
+            let (c, mut edge) = random_edge(k, 0.0, (k % 2 == 0, k % 4 < 2), k % 3 == 0);
+            for (f, w) in edge.faces.iter_mut().zip(weights(k / 3)) {
+                f.weight = w;
+            }
             let points: Vec<DVec3> = (0..LANES as u64)
                 .map(|j| {
                     DVec3::new(
@@ -352,6 +365,16 @@ mod tests {
             }
         }
         assert!(certain * 100 > total * 99, "{certain} of {total}");
+        // A face weight above the lane form's bound goes to the exact weight.
+        let (c, mut edge) = random_edge(1, 0.0, (false, false), false);
+        edge.faces[0].weight = LANE_WEIGHT_MAX as u32 + 1;
+        let tile = TileLanes::at(Vec3::ONE);
+        assert!(
+            FastWeight::new(&edge, c)
+                .unwrap()
+                .weight_lanes(&tile.quads())
+                .is_none()
+        );
     }
 
     /// The single-precision weight and test agree with the double-precision ones wherever
