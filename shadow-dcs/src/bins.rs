@@ -689,29 +689,23 @@ pub(crate) fn tile_pairs(
     }
 }
 
-/// The light-plane test of wedge `wi` from view sample `i` (`l1` at least the length of its
-/// light-centred position): `Some(None)` when the view sample takes the 3D test, `None` on the
-/// tie of the orientation.
+/// The light-plane test of wedge `wi` (`pe`, its edge in light-plane form) from view sample
+/// `i` (`l1` at least the length of its light-centred position): `None` on the tie of the
+/// orientation.
 #[inline]
 pub(crate) fn planar_test(
     input: &ScanInput,
+    pe: &PlanarEdge,
     wi: u32,
     i: usize,
     l1: f32,
-) -> Option<Option<PlanarTest>> {
-    let Some((centred_edges, pixels)) = input.planar else {
-        return Some(None);
+) -> Option<PlanarTest> {
+    let exact = || {
+        let centred_edges = input.planar.map_or(&[][..], |(e, _)| e);
+        let pc = input.origins[i].as_dvec3() - input.c;
+        centred_edges[wi as usize].orientation(pc)
     };
-    match (&input.wedges[wi as usize].planar, pixels[i]) {
-        (Some(pe), true) => {
-            let exact = || {
-                let pc = input.origins[i].as_dvec3() - input.c;
-                centred_edges[wi as usize].orientation(pc)
-            };
-            pe.test(input.centred[i], l1, exact).map(Some)
-        }
-        _ => Some(None),
-    }
+    pe.test(input.centred[i], l1, exact)
 }
 
 /// Per-thread buffers of the square scan.
@@ -766,10 +760,18 @@ pub(crate) fn square_pairs(
         let quads = tile.quads();
         let (x, y) = tiles.origin(t);
         let pixels = offsets.map(|o| y as usize * w + x as usize + o);
+        // The lanes that take the light-plane test.
+        let planar_lanes: LaneMask = match input.planar {
+            Some((_, marked)) => lanes_of(tile.active)
+                .filter(|&j| marked[pixels[j]])
+                .fold(0, |m, j| m | 1 << j),
+            None => 0,
+        };
         out.counts.scanned += u64::from(tile.active.count_ones()) * list.len() as u64;
         let entries = &mut out.entries[t * LANES..(t + 1) * LANES];
         let tests = &mut out.tests[t * LANES..(t + 1) * LANES];
         for &wi in list {
+            let pe = input.wedges[wi as usize].planar.as_ref();
             tile_pairs(
                 input,
                 wi,
@@ -778,16 +780,18 @@ pub(crate) fn square_pairs(
                 &pixels,
                 &mut out.counts,
                 |j, i, k| {
-                    match planar_test(input, wi, i, tile.l1[j]) {
-                        Some(Some(mut t)) => {
-                            t.k = k;
-                            tests[j].push(t);
-                        }
-                        Some(None) => entries[j].push(Pair { edge: wi, k }),
-                        None => {
-                            ties += 1;
-                            return;
-                        }
+                    match pe.filter(|_| planar_lanes >> j & 1 == 1) {
+                        Some(pe) => match planar_test(input, pe, wi, i, tile.l1[j]) {
+                            Some(mut t) => {
+                                t.k = k;
+                                tests[j].push(t);
+                            }
+                            None => {
+                                ties += 1;
+                                return;
+                            }
+                        },
+                        None => entries[j].push(Pair { edge: wi, k }),
                     }
                     len += 1;
                 },
