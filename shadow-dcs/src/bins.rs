@@ -368,19 +368,40 @@ pub(crate) struct BlockWedges {
     /// Per wedge, one mask word per group of [`BOXES`] blocks.
     masks: Vec<u64>,
     groups: usize,
+    /// Per block, its squares' boxes (the view samples are read once for all levels above
+    /// the tiles).
+    square_boxes: Vec<Vec<ViewBox>>,
+}
+
+/// The box of some view samples, `None` when there are none.
+type ViewBox = Option<(Vec3, Vec3)>;
+
+/// The box around some boxes.
+fn union_of<'a>(boxes: impl IntoIterator<Item = &'a ViewBox>) -> ViewBox {
+    boxes
+        .into_iter()
+        .flatten()
+        .copied()
+        .reduce(|(lo, hi), (l, h)| (lo.min(l), hi.max(h)))
 }
 
 impl BlockWedges {
     /// Every wedge against the boxes of `blocks`, [`BOXES`] blocks per test, in parallel.
     pub fn new(input: &ScanInput, blocks: &[(Rect, Vec<Rect>)]) -> Self {
-        let groups: Vec<Boxes> = blocks
+        let square_boxes: Vec<Vec<ViewBox>> = blocks
+            .par_iter()
+            .map(|(_, squares)| {
+                squares
+                    .iter()
+                    .map(|r| rect_box(*r, input.width, input.centred, input.active))
+                    .collect()
+            })
+            .collect();
+        let groups: Vec<Boxes> = square_boxes
             .chunks(BOXES)
             .map(|g| {
                 let mut b = Boxes::default();
-                b.set(
-                    g.iter()
-                        .map(|(r, _)| rect_box(*r, input.width, input.centred, input.active)),
-                );
+                b.set(g.iter().map(|squares| union_of(squares)));
                 b
             })
             .collect();
@@ -392,6 +413,7 @@ impl BlockWedges {
         Self {
             masks,
             groups: groups.len(),
+            square_boxes,
         }
     }
 
@@ -406,7 +428,7 @@ impl BlockWedges {
         squares: &[Rect],
     ) -> (Vec<Vec<u32>>, usize) {
         let (g, bit) = (block / BOXES, block % BOXES);
-        let clusters = Clusters::new(input, squares);
+        let clusters = Clusters::new(squares, &self.square_boxes[block]);
         let mut lists: Vec<Vec<u32>> = vec![Vec::new(); squares.len()];
         let mut kept = 0;
         for wi in 0..input.wedges.len() {
@@ -443,7 +465,8 @@ struct Clusters {
 }
 
 impl Clusters {
-    fn new(input: &ScanInput, squares: &[Rect]) -> Self {
+    /// The clusters of `squares`, whose boxes are `boxes`.
+    fn new(squares: &[Rect], boxes: &[ViewBox]) -> Self {
         let Some(first) = squares.first() else {
             return Self {
                 boxes: Boxes::default(),
@@ -465,20 +488,17 @@ impl Clusters {
             slots[slot] = s;
         }
         slots.resize(slots.len().next_multiple_of(4), usize::MAX);
-        let square_box = |slot: &usize| {
-            let r = squares.get(*slot)?;
-            rect_box(*r, input.width, input.centred, input.active)
-        };
-        let mut boxes = Boxes::default();
-        boxes.set(slots.chunks(4).map(|c| {
-            c.iter()
-                .filter_map(square_box)
-                .reduce(|(lo, hi), (l, h)| (lo.min(l), hi.max(h)))
-        }));
+        // Each slot's box (unused slots have none).
+        let slot_boxes: Vec<ViewBox> = slots
+            .iter()
+            .map(|&s| boxes.get(s).copied().flatten())
+            .collect();
+        let mut cluster_boxes = Boxes::default();
+        cluster_boxes.set(slot_boxes.chunks(4).map(union_of));
         let mut sq = Boxes::default();
-        sq.set(slots.iter().map(square_box));
+        sq.set(slot_boxes);
         Self {
-            boxes,
+            boxes: cluster_boxes,
             squares: sq,
             slots,
         }
