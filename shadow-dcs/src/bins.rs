@@ -401,7 +401,7 @@ impl BlockWedges {
             .chunks(BOXES)
             .map(|g| {
                 let mut b = Boxes::default();
-                b.set(g.iter().map(|squares| union_of(squares)));
+                b.set(g.iter().map(union_of));
                 b
             })
             .collect();
