@@ -4,15 +4,17 @@
 //!
 //! * **Blocks** of [`BLOCK`] x [`BLOCK`] pixels: every wedge of the light against the boxes of
 //!   up to [`BOXES`] blocks at once; each block lists the wedges its box keeps.
+//! * **Clusters** of [`CLUSTER`] x [`CLUSTER`] pixels (2 x 2 squares): each wedge of a block
+//!   against the boxes of the block's clusters.
 //! * **Squares** of [`SQUARE`] x [`SQUARE`] pixels: each wedge of a block against the boxes of
-//!   the block's squares. A square is also the unit of the per-pixel pass: its pairs are kept
-//!   until its pixels are done, which bounds their memory on scenes of very high depth
-//!   complexity (`grass`).
+//!   the squares of the clusters it keeps. A square is also the unit of the per-pixel pass:
+//!   its pairs are kept until its pixels are done, which bounds their memory on scenes of very
+//!   high depth complexity (`grass`).
 //! * **Tiles** of [`TILE_W`] x [`TILE_H`] pixels: each wedge of a square against the boxes of
 //!   the square's tiles.
-//! * **View samples** of a tile ([`crate::lanes`]): a surviving wedge's planes and its weight
-//!   `k_e(p)` on every view sample at once; each view sample inside the planes with a non-zero
-//!   weight makes a (pixel, edge) pair.
+//! * **View samples** of a tile ([`crate::lanes`]): a surviving wedge's fold planes, bounding
+//!   planes and weight `k_e(p)` on every view sample at once; each view sample inside the
+//!   planes with a non-zero weight makes a (pixel, edge) pair.
 //!
 //! A box keeps a wedge when none of the wedge's bounding planes ([`crate::wedges::wedge_planes`])
 //! has the whole box on its negative side, and the edge may be a silhouette from some point of
