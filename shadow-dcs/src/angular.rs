@@ -310,13 +310,12 @@ impl QuadRanges {
     fn of(ax: Vec4, ay: Vec4, bx: Vec4, by: Vec4) -> Self {
         let zero = Vec4::ZERO;
         let turn = Vec4::splat(TURN);
-        let angle = direction_angles;
         let la2 = ax * ax + ay * ay;
         let lb2 = bx * bx + by * by;
         let cross = ax * by - ay * bx;
         let sign = Vec4::select(cross.cmpgt(zero), Vec4::ONE, -Vec4::ONE);
-        let ta = angle(ay * sign, -ax * sign);
-        let tb = angle(by * sign, -bx * sign);
+        let ta = direction_angles(ay * sign, -ax * sign);
+        let tb = direction_angles(by * sign, -bx * sign);
         let d = tb - ta;
         let ccw = Vec4::select(tb.cmpge(ta), d, d + turn);
         let half = ccw.cmple(Vec4::splat(TURN / 2.0));

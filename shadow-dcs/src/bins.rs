@@ -152,6 +152,7 @@ pub(crate) struct Boxes {
     /// Per axis, the lower bounds, four boxes to a vector (fixed arrays: a plane's pick of
     /// bounds is then one pointer per axis, and indices below [`Boxes::quads`] need no check).
     lo: [[Vec4; BOXES / 4]; 3],
+    /// Per axis, the upper bounds, in the same layout.
     hi: [[Vec4; BOXES / 4]; 3],
     /// Vectors in use.
     quads: usize,
