@@ -76,6 +76,58 @@ pub(crate) struct ScanWedge {
     edge: u32,
     weight: Option<FastWeight>,
     planar: Option<PlanarEdge>,
+    /// The bounding planes four to a vector, for [`ScanWedge::cut_planes`].
+    cut: PlaneGroups,
+}
+
+/// Groups of four planes for [`PLANE_GROUPS`] x 4 plane slots.
+const PLANE_GROUPS: usize = BOX_PLANES.div_ceil(4);
+
+/// Relative margin of [`ScanWedge::cut_planes`]: far above the rounding of a plane evaluated at
+/// a view sample and of its bound over a tile's box.
+const CUT_PAD: f32 = 1e-5;
+
+/// A wedge's bounding planes in structure-of-arrays form: the normals' components and the
+/// offsets lowered by their margin (`d - CUT_PAD |d|`), four planes to a vector; unused slots
+/// have a zero normal and a positive offset.
+#[derive(Debug, Clone, Copy)]
+struct PlaneGroups {
+    n: [[Vec4; PLANE_GROUPS]; 3],
+    d_low: [Vec4; PLANE_GROUPS],
+}
+
+impl PlaneGroups {
+    fn new(planes: &[BoxPlane; BOX_PLANES]) -> Self {
+        let slot = |k: usize| planes.get(k).copied().unwrap_or(OPEN);
+        let group = |g: usize, f: &dyn Fn(Vec4) -> f32| {
+            Vec4::from_array(std::array::from_fn(|l| f(slot(4 * g + l))))
+        };
+        Self {
+            n: std::array::from_fn(|k| std::array::from_fn(|g| group(g, &|p: Vec4| p[k]))),
+            d_low: std::array::from_fn(|g| group(g, &|p: Vec4| p.w - CUT_PAD * p.w.abs())),
+        }
+    }
+}
+
+/// A tile's box for [`ScanWedge::cut_planes`]: its centre and its half extent (widened by
+/// the margin [`CUT_PAD`]), each coordinate in all lanes.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct TileExtent {
+    centre: [Vec4; 3],
+    half: [Vec4; 3],
+}
+
+impl TileExtent {
+    /// The extent of box `b` (an empty tile: a point at the origin, which no lane uses).
+    fn new(b: ViewBox) -> Self {
+        let (lo, hi) = b.unwrap_or((Vec3::ZERO, Vec3::ZERO));
+        let (c, h) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
+        let h = h + (c.abs() + h) * CUT_PAD;
+        Self {
+            centre: c.to_array().map(Vec4::splat),
+            half: h.to_array().map(Vec4::splat),
+        }
+    }
 }
 
 impl ScanWedge {
@@ -97,7 +149,26 @@ impl ScanWedge {
             weight: w.weight,
             planar,
             edge: w.edge,
+            cut: PlaneGroups::new(&std::array::from_fn(|k| {
+                w.planes.get(k).map_or(OPEN, plane)
+            })),
         }
+    }
+
+    /// The bounding planes (one bit each) that may put a view sample of a tile with extent
+    /// `e` on their negative side: the others are positive over the whole box, with a margin
+    /// above the rounding of the lanes' tests, and need no test on the lanes.
+    #[inline]
+    fn cut_planes(&self, e: &TileExtent) -> u32 {
+        let mut m = 0u32;
+        for g in 0..PLANE_GROUPS {
+            let [nx, ny, nz] = [self.cut.n[0][g], self.cut.n[1][g], self.cut.n[2][g]];
+            let centre = nx * e.centre[0] + ny * e.centre[1] + nz * e.centre[2] + self.cut.d_low[g];
+            let reach = nx.abs() * e.half[0] + ny.abs() * e.half[1] + nz.abs() * e.half[2];
+            // A NaN is cut: the lanes test it.
+            m |= ((!(centre - reach).cmpgt(Vec4::ZERO).bitmask() & 0xf) as u32) << (4 * g);
+        }
+        m & ((1 << self.used) - 1)
     }
 
     /// The view samples where the edge may be a silhouette (its two face planes not surely of
@@ -121,15 +192,16 @@ impl ScanWedge {
         m
     }
 
-    /// The view samples of `lanes` that no bounding plane puts on its negative side (a NaN
-    /// value rejects nothing); stops when no view sample is left.
+    /// The view samples of `lanes` that no bounding plane of `planes` (one bit each) puts on
+    /// its negative side (a NaN value rejects nothing); stops when no view sample is left.
     #[inline]
-    fn inside(&self, t: &TileQuads, lanes: LaneMask) -> LaneMask {
+    fn inside(&self, t: &TileQuads, lanes: LaneMask, planes: u32) -> LaneMask {
         let mut alive = lanes;
-        for p in &self.planes[..self.used as usize] {
+        for k in bits_of(u64::from(planes)) {
             if alive == 0 {
                 break;
             }
+            let p = &self.planes[k];
             let [nx, ny, nz, d] = p.to_array().map(Vec4::splat);
             for q in 0..QUADS {
                 let v = nx * t.x[q] + ny * t.y[q] + nz * t.z[q] + d;
@@ -621,6 +693,10 @@ pub(crate) struct SquareTiles {
     pub across: usize,
     /// Each tile's view samples.
     pub lanes: Vec<TileLanes>,
+    /// Each tile's box.
+    bounds: Vec<ViewBox>,
+    /// Each tile's box, for [`ScanWedge::cut_planes`].
+    pub extents: Vec<TileExtent>,
     /// Each tile's wedges (silhouette indices in order).
     pub lists: Vec<Vec<u32>>,
 }
@@ -637,7 +713,12 @@ impl SquareTiles {
             input.active,
             &mut self.lanes,
         );
-        self.boxes.set(self.lanes.iter().map(TileLanes::bounds));
+        self.bounds.clear();
+        self.bounds.extend(self.lanes.iter().map(TileLanes::bounds));
+        self.extents.clear();
+        self.extents
+            .extend(self.bounds.iter().map(|b| TileExtent::new(*b)));
+        self.boxes.set(self.bounds.iter().copied());
         self.lists.resize(self.lanes.len(), Vec::new());
         for l in self.lists.iter_mut() {
             l.clear();
@@ -673,6 +754,7 @@ pub(crate) fn tile_pairs(
     wi: u32,
     tile: &TileLanes,
     quads: &TileQuads,
+    extent: &TileExtent,
     pixels: &[usize; LANES],
     counts: &mut ScanCounts,
     mut pair: impl FnMut(usize, usize, i32),
@@ -688,7 +770,7 @@ pub(crate) fn tile_pairs(
     // Where the edge may be a silhouette its weight is rarely zero (on `bunny`, at no view
     // sample the fold test keeps), so the planes come first and the weights are taken only
     // for tiles with a view sample inside.
-    let inside = wedge.inside(quads, fold);
+    let inside = wedge.inside(quads, fold, wedge.cut_planes(extent));
     if inside == 0 {
         return;
     }
@@ -800,6 +882,7 @@ pub(crate) fn square_pairs(
                 wi,
                 tile,
                 &quads,
+                &tiles.extents[t],
                 &pixels,
                 &mut out.counts,
                 |j, i, k| {
@@ -833,6 +916,74 @@ mod tests {
     use crate::wedges::{FOLD_SLACK, wedges};
     use shadow_core::offset::RayOffset;
     use shadow_core::prelude::*;
+
+    /// A plane that [`ScanWedge::cut_planes`] leaves out is positive at every view sample of
+    /// the tile, far from the origin and with planes through a view sample (value zero up to
+    /// rounding); planes well clear of the box are left out.
+    #[test]
+    fn planes_left_out_of_a_tile_reject_none_of_its_view_samples() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rand = move || {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let (mut left_out, mut kept) = (0, 0);
+        for round in 0..400 {
+            let scale = [1e-3f32, 1.0, 1e3][round % 3];
+            let centre = Vec3::new(rand(), rand(), rand()) * 2.0 * scale - scale;
+            let extent = Vec3::new(rand(), rand(), rand()) * 0.01 * scale;
+            let mut tile = TileLanes::at(centre);
+            for j in 0..LANES {
+                let p = centre + (Vec3::new(rand(), rand(), rand()) * 2.0 - 1.0) * extent;
+                (tile.x[j], tile.y[j], tile.z[j]) = (p.x, p.y, p.z);
+                tile.l1[j] = p.abs().element_sum();
+            }
+            tile.active = LaneMask::MAX;
+            let quads = tile.quads();
+            let mut planes = [OPEN; BOX_PLANES];
+            for (k, plane) in planes.iter_mut().enumerate() {
+                let n = (Vec3::new(rand(), rand(), rand()) * 2.0 - 1.0).normalize_or(Vec3::X);
+                // Through a view sample, or at some distance from one (either side).
+                let j = k % LANES;
+                let at = n.dot(Vec3::new(tile.x[j], tile.y[j], tile.z[j]));
+                let shift = if k % 3 == 0 {
+                    0.0
+                } else {
+                    (rand() * 2.0 - 1.0) * extent.length() * 3.0
+                };
+                *plane = n.extend(-at + shift);
+            }
+            let w = ScanWedge {
+                planes,
+                fold: [OPEN, OPEN],
+                used: BOX_PLANES as u32,
+                edge: 0,
+                weight: None,
+                planar: None,
+                cut: PlaneGroups::new(&planes),
+            };
+            let bounds = tile.bounds();
+            let cut = w.cut_planes(&TileExtent::new(bounds));
+            for k in 0..BOX_PLANES {
+                if cut >> k & 1 == 1 {
+                    kept += 1;
+                    continue;
+                }
+                left_out += 1;
+                assert_eq!(
+                    w.inside(&quads, tile.active, 1 << k),
+                    tile.active,
+                    "round {round}, plane {k}: {:?} over {bounds:?}",
+                    planes[k]
+                );
+                assert!(k % 3 != 0, "a plane through a view sample is always tested");
+            }
+        }
+        assert!(
+            left_out > 500 && kept > 1000,
+            "{left_out} left out, {kept} kept"
+        );
+    }
 
     /// The box hierarchy finds exactly the (pixel, wedge, weight) pairs of a brute-force scan
     /// of every view sample against every wedge (inside the bounding planes, non-zero exact
@@ -895,7 +1046,7 @@ mod tests {
                 }
                 let q = TileLanes::at(centred[i]).quads();
                 for (wi, sw) in scan.iter().enumerate() {
-                    if sw.inside(&q, 1) == 0 {
+                    if sw.inside(&q, 1, (1 << sw.used) - 1) == 0 {
                         continue;
                     }
                     let e = &edges[sw.edge as usize];
