@@ -166,7 +166,7 @@ impl ScanWedge {
             let centre = nx * e.centre[0] + ny * e.centre[1] + nz * e.centre[2] + self.cut.d_low[g];
             let reach = nx.abs() * e.half[0] + ny.abs() * e.half[1] + nz.abs() * e.half[2];
             // A NaN is cut: the lanes test it.
-            m |= ((!(centre - reach).cmpgt(Vec4::ZERO).bitmask() & 0xf) as u32) << (4 * g);
+            m |= (!(centre - reach).cmpgt(Vec4::ZERO).bitmask() & 0xf) << (4 * g);
         }
         m & ((1 << self.used) - 1)
     }
