@@ -309,8 +309,20 @@ impl Boxes {
     /// sign over it (a NaN keeps the box). `slack` is the fold test's slack.
     #[inline]
     pub fn test(&self, w: &ScanWedge, slack: f32) -> u64 {
-        let quads = self.quads.min(BOXES / 4);
-        let mut reject = [BVec4A::splat(false); BOXES / 4];
+        // Up to 16 boxes (a square's tiles, a block's clusters): four vectors, unrolled, the
+        // rejections in registers; the unused vectors' boxes are not valid.
+        if self.quads <= SMALL_QUADS {
+            self.test_quads_up_to::<SMALL_QUADS>(w, slack, SMALL_QUADS)
+        } else {
+            self.test_quads_up_to::<{ BOXES / 4 }>(w, slack, self.quads)
+        }
+    }
+
+    /// [`Boxes::test`] on the first `quads` vectors (at most `Q`).
+    #[inline(always)]
+    fn test_quads_up_to<const Q: usize>(&self, w: &ScanWedge, slack: f32, quads: usize) -> u64 {
+        let quads = quads.min(Q);
+        let mut reject = [BVec4A::splat(false); Q];
         for p in &w.planes[..w.used as usize] {
             let ([x, y, z], _) = self.corners(*p);
             let n = splat(*p);
@@ -326,6 +338,9 @@ impl Boxes {
         mask & self.valid
     }
 }
+
+/// Vectors of boxes that [`Boxes::test`] tests unrolled.
+const SMALL_QUADS: usize = 4;
 
 /// Per axis, one bound array of a [`Boxes`] for the farthest corners, then for the nearest.
 type Corners<'a> = ([&'a [Vec4; BOXES / 4]; 3], [&'a [Vec4; BOXES / 4]; 3]);
