@@ -935,6 +935,66 @@ mod tests {
     use shadow_core::offset::RayOffset;
     use shadow_core::prelude::*;
 
+    /// The box test keeps the same boxes whether it runs unrolled (up to 16 boxes) or over
+    /// all 64, and as [`Boxes::test_quads`] on every vector: the wedges of `bunny` against
+    /// boxes around its view samples, some of them empty.
+    #[test]
+    fn box_tests_agree_unrolled_and_not() {
+        let setup = shadow_core::scenes::builtin("bunny").unwrap();
+        let scene = setup.scene.as_ref();
+        let (w, h) = (64, 48);
+        let view = ViewSamples::render(scene, &setup.camera_or_default(), w, h).unwrap();
+        let light = setup.lights[0].as_ref();
+        let shape = LightShape::new(light, "test").unwrap();
+        let (edges, _) = scene_edges(scene, shape.center);
+        let sil = silhouettes(&edges, &shape, Silhouettes::Accurate);
+        let scan: Vec<ScanWedge> = wedges(&edges, &sil, &shape)
+            .iter()
+            .map(|w| ScanWedge::new(w, None))
+            .collect();
+        let c = shape.center.as_dvec3();
+        let n = view.len();
+        let mut centred = vec![Vec3::ZERO; n];
+        let mut active = vec![false; n];
+        for i in 0..n {
+            if let Some(s) = view.get(i) {
+                centred[i] = (s.position.as_dvec3() - c).as_vec3();
+                active[i] = true;
+            }
+        }
+        // Boxes of 4 x 4 pixels over the whole image: 192, shuffled (so that every vector
+        // holds some the wedges meet), taken 16 and 64 at a time.
+        let grid_boxes: Vec<ViewBox> = grid((0, w - 1), (0, h - 1), 4)
+            .map(|r| rect_box(r, w, &centred, &active))
+            .collect();
+        let boxes: Vec<ViewBox> = (0..grid_boxes.len())
+            .map(|i| grid_boxes[i * 37 % grid_boxes.len()])
+            .collect();
+        assert!(boxes.iter().any(Option::is_none), "some boxes are empty");
+        let slack = 1e-6;
+        let (mut kept, mut compared) = (0u32, 0u32);
+        for big in boxes.chunks(BOXES) {
+            let mut all = Boxes::default();
+            all.set(big.iter().copied());
+            for (g, small) in big.chunks(16).enumerate() {
+                let mut few = Boxes::default();
+                few.set(small.iter().copied());
+                for sw in scan.iter().step_by(7) {
+                    let want = few.test(sw, slack);
+                    let got = all.test(sw, slack) >> (16 * g) & 0xffff;
+                    assert_eq!(got, want);
+                    assert_eq!(few.test_quads(sw, slack, 0xf), want);
+                    kept += want.count_ones();
+                    compared += 1;
+                }
+            }
+        }
+        assert!(
+            compared > 1000 && kept > 100,
+            "{kept} kept in {compared} tests"
+        );
+    }
+
     /// A plane that [`ScanWedge::cut_planes`] leaves out is positive at every view sample of
     /// the tile, far from the origin and with planes through a view sample (value zero up to
     /// rounding); planes well clear of the box are left out.
