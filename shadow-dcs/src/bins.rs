@@ -144,16 +144,15 @@ impl ScanWedge {
             Some((a, b)) => [plane(a), plane(b)],
             None => [OPEN, OPEN],
         };
+        let planes = std::array::from_fn(|k| w.planes.get(k).map_or(OPEN, plane));
         Self {
-            planes: std::array::from_fn(|k| w.planes.get(k).map_or(OPEN, plane)),
+            planes,
             used: w.planes.len().min(BOX_PLANES) as u32,
             fold,
             weight: w.weight,
             planar,
             edge: w.edge,
-            cut: PlaneGroups::new(&std::array::from_fn(|k| {
-                w.planes.get(k).map_or(OPEN, plane)
-            })),
+            cut: PlaneGroups::new(&planes),
         }
     }
 
@@ -763,9 +762,9 @@ impl SquareTiles {
 /// The pairs of wedge `wi` with the view samples of a tile (`tile`, `quads`, its box `extent`,
 /// the image index of each lane in `pixels`): the fold planes (where the edge may be a
 /// silhouette), then the bounding planes that may cut the tile's box on the view samples left,
-/// then the weights where any is inside,
-/// exact where the single-precision signs are uncertain. Calls `pair(lane, image index, k)` for
-/// each view sample with a non-zero weight, in lane order.
+/// then the weights where any is inside, exact where the single-precision signs are uncertain.
+/// Calls `pair(lane, image index, k)` for each view sample with a non-zero weight, in lane
+/// order.
 #[inline]
 pub(crate) fn tile_pairs(
     input: &ScanInput,
