@@ -68,14 +68,22 @@ const OPEN: BoxPlane = Vec4::new(0.0, 0.0, 0.0, 1.0);
 /// silhouette order, square by square): its bounding planes and the planes of its edge's two
 /// faces for box tests (the bounding planes also test view samples), its weight from plane
 /// signs, and its edge prepared for the light-plane test.
+///
+/// Laid out in declaration order (`repr(C)`) on cache-line boundaries, so that a box test's
+/// data (the count, the fold planes, then the bounding planes in use) fills the wedge's first
+/// lines: up to nine planes in three lines. Left to the compiler, the fields were reordered
+/// (the tile data first, the count after the weight), and a box test touched five lines of 656
+/// bytes; in declaration order `bunny`'s simulated last-level misses fell by 10% (3,029 k to
+/// 2,729 k), with no change in wall time measured.
 #[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
 pub(crate) struct ScanWedge {
-    planes: [BoxPlane; BOX_PLANES],
-    fold: [BoxPlane; 2],
     /// Bounding planes in use (the rest are open).
     used: u32,
     /// The scene edge.
     edge: u32,
+    fold: [BoxPlane; 2],
+    planes: [BoxPlane; BOX_PLANES],
     weight: Option<FastWeight>,
     planar: Option<PlanarEdge>,
     /// The bounding planes four to a vector, for [`ScanWedge::cut_planes`].
