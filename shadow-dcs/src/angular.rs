@@ -129,6 +129,18 @@ impl AngularIndex {
         self.words = words;
         self.prefix.clear();
         self.prefix.resize((BUCKETS + 1) * words, 0);
+        if let Ok(table) = <&mut [u64; BUCKETS + 1]>::try_from(&mut self.prefix[..]) {
+            // One word (up to 64 samples): a fixed table, no index arithmetic or checks.
+            for (k, b) in self.buckets.iter().enumerate() {
+                table[(*b as usize).min(BUCKETS - 1) + 1] |= 1 << (k & 63);
+            }
+            let mut acc = 0;
+            for x in table.iter_mut() {
+                acc |= *x;
+                *x = acc;
+            }
+            return;
+        }
         for (k, b) in self.buckets.iter().enumerate() {
             self.prefix[(*b as usize + 1) * words + k / 64] |= 1 << (k % 64);
         }
