@@ -130,7 +130,8 @@ impl AngularIndex {
         self.prefix.clear();
         self.prefix.resize((BUCKETS + 1) * words, 0);
         if let Ok(table) = <&mut [u64; BUCKETS + 1]>::try_from(&mut self.prefix[..]) {
-            // One word (up to 64 samples): a fixed table, no index arithmetic or checks.
+            // One word (up to 64 samples): a fixed table, no index arithmetic or checks (the
+            // buckets are below `BUCKETS`; the `min` only lets the compiler drop the check).
             for (k, b) in self.buckets.iter().enumerate() {
                 table[(*b as usize).min(BUCKETS - 1) + 1] |= 1 << (k & 63);
             }
@@ -144,18 +145,11 @@ impl AngularIndex {
         for (k, b) in self.buckets.iter().enumerate() {
             self.prefix[(*b as usize + 1) * words + k / 64] |= 1 << (k % 64);
         }
-        if words == 1 {
-            let mut acc = 0;
-            for x in &mut self.prefix {
-                acc |= *x;
-                *x = acc;
-            }
-        } else {
-            for j in 1..=BUCKETS {
-                let (done, rest) = self.prefix.split_at_mut(j * words);
-                for (x, below) in rest[..words].iter_mut().zip(&done[(j - 1) * words..]) {
-                    *x |= *below;
-                }
+        // Two words or more (one word took the fixed table above).
+        for j in 1..=BUCKETS {
+            let (done, rest) = self.prefix.split_at_mut(j * words);
+            for (x, below) in rest[..words].iter_mut().zip(&done[(j - 1) * words..]) {
+                *x |= *below;
             }
         }
     }
