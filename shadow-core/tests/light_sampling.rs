@@ -4,6 +4,7 @@
 use std::f32::consts::PI;
 
 use glam::{UVec2, Vec2, Vec3};
+use shadow_core::light::TexturedRadiance;
 use shadow_core::prelude::*;
 use shadow_core::sampling::{MAX_SAMPLES, hash_words, unit_float};
 
@@ -309,4 +310,47 @@ fn bounding_quads_hold_their_lights() {
     );
     let sphere = SphereLight::new(Vec3::ZERO, 0.5, r).unwrap();
     assert!(sphere.geometry().bounding_quad().is_none());
+}
+
+/// A set's samples (`sample_into`) and radiances (`radiances_into`) equal the single samples
+/// of [`AreaLight::sample`], for every light kind, with constant and textured radiance.
+#[test]
+fn set_samples_and_radiances_equal_single_samples() {
+    let texels: Vec<Vec3> = (0..12)
+        .map(|k| Vec3::new(k as f32, (k * 5 % 7) as f32, 1.0 + (k % 3) as f32))
+        .collect();
+    let textured = Radiance::Textured(
+        TexturedRadiance::new(
+            4,
+            3,
+            texels,
+            Vec3::new(1.0, 0.5, 2.0),
+            glam::Affine2::from_scale(Vec2::new(1.5, -2.0)),
+        )
+        .unwrap(),
+    );
+    let square =
+        [(0.0, 0.0), (0.0, 1.0), (1.0, 1.0), (1.0, 0.0)].map(|(x, z)| Vec3::new(x, 1.0, z));
+    let units = uniform(500, 11);
+    for radiance in [Radiance::Constant(Vec3::new(2.0, 1.0, 0.5)), textured] {
+        let lights: Vec<Box<dyn AreaLight>> = vec![
+            Box::new(RectLight::new(Vec3::Y, Vec3::X, Vec3::Z, radiance.clone()).unwrap()),
+            Box::new(DiskLight::new(Vec3::Y, Vec3::NEG_Y, 0.5, radiance.clone()).unwrap()),
+            Box::new(SphereLight::new(Vec3::Y, 0.5, radiance.clone()).unwrap()),
+            Box::new(PolygonLight::new(square.to_vec(), radiance.clone()).unwrap()),
+        ];
+        for l in &lights {
+            let (mut set, mut radiances) = (vec![], vec![]);
+            l.sample_into(&units, &mut set);
+            l.radiances_into(&units, &mut radiances);
+            assert_eq!(set.len(), units.len());
+            assert_eq!(radiances.len(), units.len());
+            for ((s, r), u) in set.iter().zip(&radiances).zip(&units) {
+                let one = l.sample(*u);
+                assert_eq!(*s, one, "{l:?} at {u}");
+                assert_eq!(*r, one.radiance, "{l:?} at {u}");
+                assert_eq!(one.radiance, l.radiance().at(one.uv));
+            }
+        }
+    }
 }

@@ -192,6 +192,8 @@ struct Refined<'a> {
 struct Scratch {
     units: Vec<Vec2>,
     samples: Vec<LightSample>,
+    /// The samples' radiances (textured lights: they weigh eq. 2).
+    radiances: Vec<Vec3>,
     positions: Vec<Vec3>,
     relative: RelativeSamples,
     angular: AngularIndex,
@@ -515,9 +517,10 @@ impl Dcs {
     }
 
     /// Per-sample visibility of pixel `i` into `scratch.visible` (with `scratch.want_values`,
-    /// also `scratch.vis` and depth complexities into `scratch.depth`), and its light samples
-    /// into `scratch.samples` when the light is textured (their radiances weigh eq. 2; none for
-    /// a pixel whose integration constant alone puts it in the umbra), from its
+    /// also `scratch.vis` and depth complexities into `scratch.depth`), and its samples'
+    /// radiances into `scratch.radiances` when the light is textured (they weigh eq. 2; none for
+    /// a pixel whose integration constant alone puts it in the umbra; the whole light samples
+    /// into `scratch.samples` only where the samples were set up), from its
     /// wedge pairs `entries` (and, for the light-plane test, their `tests`). Returns the class.
     #[allow(clippy::too_many_arguments)]
     fn pixel(
@@ -624,6 +627,7 @@ impl Dcs {
         scratch.vis.clear();
         scratch.depth.clear();
         scratch.samples.clear();
+        scratch.radiances.clear();
         scratch.visible.clear();
         scratch.visible.resize(n.div_ceil(64), 0);
         scratch.masks.clear();
@@ -708,11 +712,12 @@ impl Dcs {
                 scratch.vis.resize(n, v);
                 scratch.depth.resize(n, d0);
             }
-            // In the umbra every sample's weight is zero: eq. 2 needs no radiance.
+            // In the umbra every sample's weight is zero: eq. 2 needs no radiance. Elsewhere
+            // only the radiances, not the positions.
             if textured && v > 0.0 {
                 self.sampler.unit_samples(s.pixel, &mut scratch.units);
                 let light = p.light.as_ref();
-                light.sample_into(&scratch.units, &mut scratch.samples);
+                light.radiances_into(&scratch.units, &mut scratch.radiances);
             }
             return if d0 == 0 {
                 PixelClass::Lit
@@ -834,6 +839,7 @@ impl Dcs {
         self.sampler.unit_samples(s.pixel, &mut scratch.units);
         let light = p.light.as_ref();
         scratch.samples.clear();
+        scratch.radiances.clear();
         scratch.positions.clear();
         // A constant rectangle light wholly above the receiver needs no world positions: the
         // light-plane coordinates are an affine map of the unit samples (positions are still
@@ -845,6 +851,9 @@ impl Dcs {
             scratch
                 .positions
                 .extend(scratch.samples.iter().map(|l| l.position));
+            scratch
+                .radiances
+                .extend(scratch.samples.iter().map(|l| l.radiance));
         } else if rect.is_none() || cfg!(debug_assertions) {
             light.positions_into(&scratch.units, &mut scratch.positions);
         }
@@ -1376,10 +1385,10 @@ impl ShadowTechnique for Dcs {
                         r.v[x] = (sum / n as f64) as f32;
                         if textured {
                             let acc = scratch
-                                .samples
+                                .radiances
                                 .iter()
                                 .zip(vis)
-                                .fold(Vec3::ZERO, |a, (l, v)| a + l.radiance * *v);
+                                .fold(Vec3::ZERO, |a, (l, v)| a + *l * *v);
                             r.rgb[x] = acc / n as f32;
                         }
                         match output {

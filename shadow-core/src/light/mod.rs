@@ -248,7 +248,21 @@ pub trait AreaLight: Send + Sync + Debug {
     /// The samples at every `u` of `units`, appended to `out`: one dynamic call for a whole
     /// set, inside which [`AreaLight::sample`] is a static call the compiler can inline.
     fn sample_into(&self, units: &[Vec2], out: &mut Vec<LightSample>) {
-        out.extend(units.iter().map(|u| self.sample(*u)));
+        // The radiance's kind is settled once per set, not per sample.
+        match self.radiance() {
+            Radiance::Constant(c) => samples_with(self, units, |_| *c, out),
+            Radiance::Textured(t) => samples_with(self, units, |uv| t.lookup(uv), out),
+        }
+    }
+    /// The radiances at every `u` of `units` (those of [`AreaLight::sample_into`]), appended to
+    /// `out`, one dynamic call for a whole set: for callers that need no positions (the
+    /// radiance-weighted visibility of a pixel whose samples all see the light), so that only
+    /// the texture coordinates of [`AreaLight::point_at`] are computed.
+    fn radiances_into(&self, units: &[Vec2], out: &mut Vec<Vec3>) {
+        match self.radiance() {
+            Radiance::Constant(c) => out.extend(std::iter::repeat_n(*c, units.len())),
+            Radiance::Textured(t) => t.extend_at(units.iter().map(|u| self.point_at(*u).2), out),
+        }
     }
     /// The positions at every `u` of `units` ([`AreaLight::point_at`]), appended to `out`, one
     /// dynamic call for a whole set.
@@ -263,6 +277,25 @@ pub trait AreaLight: Send + Sync + Debug {
     fn is_textured(&self) -> bool {
         matches!(self.radiance(), Radiance::Textured(_))
     }
+}
+
+/// [`AreaLight::sample_into`] with the radiance at uv given by `radiance`.
+#[inline(always)]
+fn samples_with<L: AreaLight + ?Sized>(
+    light: &L,
+    units: &[Vec2],
+    radiance: impl Fn(Vec2) -> Vec3,
+    out: &mut Vec<LightSample>,
+) {
+    out.extend(units.iter().map(|u| {
+        let (position, normal, uv) = light.point_at(*u);
+        LightSample {
+            position,
+            normal,
+            uv,
+            radiance: radiance(uv),
+        }
+    }));
 }
 
 /// A shared, immutable light as scenes and techniques pass it around.
