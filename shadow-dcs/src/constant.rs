@@ -10,8 +10,9 @@
 //!
 //! `D(p, c) = D(eye, c) + sum of k_e over the quads the eye segment crosses before p`.
 //!
-//! Quads are scan-converted into the camera image with the core rasterizer's coverage rule (a
-//! pixel on an edge shared by two quads is counted once); at each covered pixel an exact
+//! Quads are scan-converted whole into the camera image (`CoveredPolygon`: one run of pixels
+//! per row and quad) with the core rasterizer's coverage rule (a pixel on an edge shared by
+//! two quads is counted once); at each covered pixel an exact
 //! orientation test decides whether the quad's plane lies between the eye and the view sample
 //! (the depth test of a stencil shadow volume). `D(eye, c)` is the only ray-cast value: one
 //! segment per frame. Quads end at a radius from `c` beyond every view sample and the eye, with
@@ -20,7 +21,7 @@
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use shadow_core::raster::{CoveredPixels, Projection, RasterView};
+use shadow_core::raster::{CoveredPolygon, Projection, RasterView};
 use shadow_core::scene::Scene;
 
 use crate::edges::{SceneEdge, ray_hits_triangle};
@@ -140,27 +141,20 @@ pub(crate) fn integration_constants(
     let near_view = near_zero(view, far_radius);
     let w = view.width as usize;
     let n = origins.len();
-    // Each quad's fan of screen triangles, set up once, then binned by bands of rows: every
-    // band sums its own rows, so no image-sized accumulator is merged.
-    let triangles: Vec<(CoveredPixels, u32)> = quads
+    // Each quad set up once as a whole polygon (one run per row, not one per fan triangle),
+    // then binned by bands of rows: every band sums its own rows, so no image-sized
+    // accumulator is merged.
+    let polygons: Vec<CoveredPolygon> = quads
         .par_iter()
-        .enumerate()
-        .flat_map_iter(|(qi, (q, ..))| {
-            (1..q.len() - 1).map(move |j| {
-                (
-                    CoveredPixels::new(&near_view, [q[0], q[j], q[j + 1]]),
-                    qi as u32,
-                )
-            })
-        })
+        .map(|(q, ..)| CoveredPolygon::new(&near_view, q))
         .collect();
     let bands = view.height.div_ceil(SV_BAND) as usize;
     let mut bins: Vec<Vec<u32>> = vec![Vec::new(); bands];
-    for (t, (tri, _)) in triangles.iter().enumerate() {
-        if let Some((y0, y1)) = tri.rows() {
+    for (qi, poly) in polygons.iter().enumerate() {
+        if let Some((y0, y1)) = poly.rows() {
             let last = ((y1 / SV_BAND) as usize).min(bands.saturating_sub(1));
             for bin in &mut bins[(y0 / SV_BAND) as usize..=last] {
-                bin.push(t as u32);
+                bin.push(qi as u32);
             }
         }
     }
@@ -187,11 +181,10 @@ pub(crate) fn integration_constants(
             let y0 = band as u32 * SV_BAND;
             let y1 = y0 + SV_BAND - 1;
             let first = y0 as usize * w;
-            for &t in bin {
-                let (tri, qi) = &triangles[t as usize];
-                let (_, k, normal, eye_positive) = &quads[*qi as usize];
-                let (nf, bound) = sides[*qi as usize];
-                tri.for_each_span_in_rows(y0, y1, |y, x0, x1| {
+            for &qi in bin {
+                let (_, k, normal, eye_positive) = &quads[qi as usize];
+                let (nf, bound) = sides[qi as usize];
+                polygons[qi as usize].for_each_span_in_rows(y0, y1, |y, x0, x1| {
                     let row = y as usize * w;
                     for i in row + x0 as usize..=row + x1 as usize {
                         if !valid[i] {

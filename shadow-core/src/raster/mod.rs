@@ -8,6 +8,8 @@
 //!   perspective-correctly (`1/d` is affine in screen space).
 //! * `k`-layer depth peeling in one pass: each pixel keeps its `k` nearest fragments with
 //!   strictly increasing depth (BCS06 section 4 takes such layers from the light).
+//! * Coverage alone (no depth) of world-space triangles ([`CoveredPixels`]) and of whole convex
+//!   planar polygons ([`CoveredPolygon`], one run of pixels per row), by bands of rows.
 //! * rayon over bands of rows; triangles are visited in index order inside a band and depth ties
 //!   keep the first, so the result is identical whatever the thread count.
 
@@ -17,7 +19,7 @@ use glam::{Affine3A, Vec3};
 use rayon::prelude::*;
 use thiserror::Error;
 
-use setup::{ScreenTriangle, setup_triangle};
+use setup::{ConvexRows, ScreenPolygon, ScreenTriangle, setup_polygon, setup_triangle};
 
 /// Largest `width * height * layers` the rasterizer accepts (256 Mi fragments).
 pub const MAX_FRAGMENTS: u64 = 1 << 28;
@@ -229,6 +231,53 @@ impl CoveredPixels {
     }
 }
 
+/// A world-space convex planar polygon set up whole for scan conversion, with the coverage of
+/// [`CoveredPixels`] (near-plane clipping, top-left rule on each edge): the pixels of the union
+/// of its fan triangles, each once, but one run per row for the whole polygon instead of one
+/// per triangle. DCS's shadow-volume quads (section 4.1) are rasterized this way.
+#[derive(Debug, Clone)]
+pub struct CoveredPolygon {
+    part: Option<ScreenPolygon>,
+}
+
+impl CoveredPolygon {
+    /// Sets up the convex planar polygon `outline` (vertices in order, either winding) in
+    /// `view`.
+    pub fn new(view: &RasterView, outline: &[Vec3]) -> Self {
+        let v: Vec<Vec3> = outline
+            .iter()
+            .map(|p| view.view_from_world.transform_point3(*p))
+            .collect();
+        Self {
+            part: setup_polygon(&v, view),
+        }
+    }
+
+    /// The first and last rows that may hold covered pixels; `None` when none can.
+    pub fn rows(&self) -> Option<(u32, u32)> {
+        self.part.as_ref().map(|s| (s.ymin, s.ymax))
+    }
+
+    /// Calls `f(y, x0, x1)` for every row `y` in `y0..=y1` with covered pixels, with its run
+    /// `x0..=x1` of covered pixels (coverage along a row of a convex polygon is an interval).
+    pub fn for_each_span_in_rows(&self, y0: u32, y1: u32, mut f: impl FnMut(u32, u32, u32)) {
+        if let Some(st) = &self.part {
+            for y in st.ymin.max(y0)..=st.ymax.min(y1) {
+                if let Some((x0, x1)) = st.row_span(y) {
+                    f(y, x0, x1);
+                }
+            }
+        }
+    }
+
+    /// True when the polygon covers the centre of pixel `(x, y)`.
+    pub fn covers(&self, x: u32, y: u32) -> bool {
+        self.part.as_ref().is_some_and(|s| {
+            (s.xmin..=s.xmax).contains(&x) && (s.ymin..=s.ymax).contains(&y) && s.covers(x, y)
+        })
+    }
+}
+
 /// The fragments kept per pixel: triangle ids and linear depths, `layers` per pixel, nearest
 /// first. Unused layers hold [`NO_TRIANGLE`] and `f32::INFINITY`.
 #[derive(Debug, Clone, PartialEq)]
@@ -390,11 +439,9 @@ mod tests {
         ));
     }
 
-    /// Visiting a triangle band by band reports the same pixels, once each, as one visit of
-    /// the whole image, a triangle clipped by the near plane included.
-    #[test]
-    fn covered_pixels_by_bands_equal_the_whole_visit() {
-        let view = RasterView {
+    /// A perspective view of 37 x 29 pixels with the near plane at 0.1.
+    fn persp_view() -> RasterView {
+        RasterView {
             width: 37,
             height: 29,
             view_from_world: Affine3A::IDENTITY,
@@ -405,7 +452,30 @@ mod tests {
                 top: 0.8,
                 near: 0.1,
             },
-        };
+        }
+    }
+
+    /// An orthographic view of 32 x 32 pixels over `[0, 32]^2`.
+    fn ortho_view() -> RasterView {
+        RasterView {
+            width: 32,
+            height: 32,
+            view_from_world: Affine3A::IDENTITY,
+            projection: Projection::Orthographic {
+                left: 0.0,
+                right: 32.0,
+                bottom: 0.0,
+                top: 32.0,
+                near: 0.1,
+            },
+        }
+    }
+
+    /// Visiting a triangle band by band reports the same pixels, once each, as one visit of
+    /// the whole image, a triangle clipped by the near plane included.
+    #[test]
+    fn covered_pixels_by_bands_equal_the_whole_visit() {
+        let view = persp_view();
         // Random triangles too, some crossing the near plane, some thin.
         let r = |k: u64, i: u64| {
             crate::sampling::unit_float(crate::sampling::hash_words(&[k, i])) * 2.0 - 1.0
@@ -479,18 +549,7 @@ mod tests {
     /// visit, ties included.
     #[test]
     fn row_runs_settle_ties_like_the_pixel_test() {
-        let view = RasterView {
-            width: 32,
-            height: 32,
-            view_from_world: Affine3A::IDENTITY,
-            projection: Projection::Orthographic {
-                left: 0.0,
-                right: 32.0,
-                bottom: 0.0,
-                top: 32.0,
-                near: 0.1,
-            },
-        };
+        let view = ortho_view();
         let mut ties = 0;
         for k in 0..400u64 {
             let r = |i: u64| crate::sampling::hash_words(&[k, i]) % 65;
@@ -525,5 +584,119 @@ mod tests {
                 .count();
         }
         assert!(ties > 50, "{ties} pixels on an edge");
+    }
+
+    /// The pixels `CoveredPixels` reports for the fan triangles of `outline`.
+    fn fan_pixels(view: &RasterView, outline: &[Vec3]) -> Vec<(u32, u32)> {
+        let mut out = Vec::new();
+        for j in 1..outline.len() - 1 {
+            let tri = [outline[0], outline[j], outline[j + 1]];
+            CoveredPixels::new(view, tri).for_each_in_rows(0, u32::MAX, |x, y| out.push((x, y)));
+        }
+        out.sort_unstable();
+        out
+    }
+
+    /// The runs of `outline` as a whole polygon, checked against its per-pixel test.
+    fn polygon_pixels(view: &RasterView, outline: &[Vec3]) -> Vec<(u32, u32)> {
+        let cover = CoveredPolygon::new(view, outline);
+        let mut out = Vec::new();
+        cover.for_each_span_in_rows(0, view.height, |y, x0, x1| {
+            out.extend((x0..=x1).map(|x| (x, y)));
+        });
+        out.sort_unstable();
+        let tested: Vec<(u32, u32)> = (0..view.height)
+            .flat_map(|y| (0..view.width).map(move |x| (x, y)))
+            .filter(|&(x, y)| cover.covers(x, y))
+            .collect::<std::collections::BTreeSet<_>>()
+            .into_iter()
+            .collect();
+        let mut sorted = tested.clone();
+        sorted.sort_unstable();
+        assert_eq!(out, sorted, "runs and the pixel test of {outline:?}");
+        out
+    }
+
+    /// A whole convex polygon covers the pixels of its fan triangles, each once: random
+    /// planar quads and pentagons in perspective (some crossing the near plane, some thin), and
+    /// quads with vertices on the half-pixel grid, whose pixel centres lie on edges (the
+    /// top-left rule settles them as for the triangles). Two quads sharing an edge cover each
+    /// pixel of their union once.
+    #[test]
+    fn covered_polygons_equal_their_fan_triangles() {
+        let persp = persp_view();
+        let r = |k: u64, i: u64| {
+            crate::sampling::unit_float(crate::sampling::hash_words(&[k, i])) * 2.0 - 1.0
+        };
+        let mut covered = 0;
+        for k in 0..300u64 {
+            // A convex outline: points on an ellipse at increasing angles, in a tilted plane.
+            let n = 4 + (k % 2) as usize;
+            let (cx, cy, cz) = (r(k, 0), r(k, 1), -2.0 + 1.8 * r(k, 2));
+            let (ra, rb) = (0.2 + 2.0 * r(k, 3).abs(), 0.01 + 1.5 * r(k, 4).abs());
+            let (tx, ty) = (r(k, 5), r(k, 6));
+            let outline: Vec<Vec3> = (0..n)
+                .map(|j| {
+                    let t =
+                        (j as f32 + 0.4 * r(k, 10 + j as u64)) * std::f32::consts::TAU / n as f32;
+                    let (u, v) = (ra * t.cos(), rb * t.sin());
+                    Vec3::new(cx + u, cy + v, cz + tx * u + ty * v)
+                })
+                .collect();
+            let fan = fan_pixels(&persp, &outline);
+            let whole = polygon_pixels(&persp, &outline);
+            let mut dedup = fan.clone();
+            dedup.dedup();
+            assert_eq!(
+                dedup.len(),
+                fan.len(),
+                "polygon {k}: a fan pixel reported twice"
+            );
+            assert_eq!(whole, fan, "polygon {k}: {outline:?}");
+            covered += usize::from(!whole.is_empty());
+        }
+        assert!(covered > 100, "{covered}");
+        let ortho = ortho_view();
+        let (mut shared, mut on_edge) = (0, 0);
+        for k in 0..400u64 {
+            let g = |i: u64| (crate::sampling::hash_words(&[k, i]) % 65) as f32 * 0.5 - 0.25;
+            // A convex quad on the half-pixel grid: a triangle's vertices and a fourth beyond
+            // its first edge, kept when the outline stays convex.
+            let (a, b, c) = (
+                Vec3::new(g(0), g(1), -1.0),
+                Vec3::new(g(2), g(3), -1.0),
+                Vec3::new(g(4), g(5), -1.0),
+            );
+            let d = Vec3::new(g(6), g(7), -1.0);
+            let turn = |p: Vec3, q: Vec3, s: Vec3| (q - p).truncate().perp_dot((s - q).truncate());
+            let outline = [a, d, b, c];
+            let signs = [turn(a, d, b), turn(d, b, c), turn(b, c, a), turn(c, a, d)];
+            if !(signs.iter().all(|&t| t > 0.0) || signs.iter().all(|&t| t < 0.0)) {
+                continue;
+            }
+            let whole = polygon_pixels(&ortho, &outline);
+            assert_eq!(whole, fan_pixels(&ortho, &outline), "quad {k}: {outline:?}");
+            // Its neighbour across the edge b c (the mirror of a and d through that edge's
+            // midpoint): together they cover each pixel once.
+            let m = (b + c) * 0.5;
+            let other = [b, c, 2.0 * m - a];
+            let mut both = whole.clone();
+            both.extend(polygon_pixels(&ortho, &other));
+            let n = both.len();
+            both.sort_unstable();
+            both.dedup();
+            assert_eq!(n, both.len(), "quad {k} and its neighbour share a pixel");
+            shared += 1;
+            // Pixels whose centre lies on the shared edge (y flipped: row 0 is the top).
+            on_edge += both
+                .iter()
+                .filter(|(x, y)| {
+                    let p = glam::Vec2::new(*x as f32 + 0.5, 31.5 - *y as f32);
+                    (c - b).truncate().perp_dot(p - b.truncate()) == 0.0
+                })
+                .count();
+        }
+        assert!(shared > 50, "{shared}");
+        assert!(on_edge > 20, "{on_edge} pixels on a shared edge");
     }
 }

@@ -64,22 +64,99 @@ impl ScreenTriangle {
         Some(w)
     }
 
-    /// True when the centre of pixel `(x, y)` is covered (top-left rule).
-    pub fn covers(&self, x: u32, y: u32) -> bool {
+    /// Linear depth at the centre of pixel `(x, y)` when covered.
+    pub fn depth_at_center(&self, x: u32, y: u32) -> Option<f32> {
+        let w = self.weights_at(x, y)?;
+        let (b0, b1, b2) = (w[0] / self.area, w[1] / self.area, w[2] / self.area);
+        let zi = b0 * self.z[0] + b1 * self.z[1] + b2 * self.z[2];
+        let d = if self.perspective { 1.0 / zi } else { zi };
+        let d = d as f32;
+        d.is_finite().then_some(d)
+    }
+}
+
+/// The [`ConvexRows`] accessors of a set-up with fields `p`, `top_left`, `cross`, `xmin` and
+/// `xmax`.
+macro_rules! convex_fields {
+    () => {
+        fn vertices(&self) -> &[DVec2] {
+            &self.p
+        }
+        fn top_left(&self) -> &[bool] {
+            &self.top_left
+        }
+        fn crossings(&self) -> &[(f64, f64, f64)] {
+            &self.cross
+        }
+        fn x_range(&self) -> (u32, u32) {
+            (self.xmin, self.xmax)
+        }
+    };
+}
+
+impl ConvexRows for ScreenTriangle {
+    convex_fields!();
+    fn covers(&self, x: u32, y: u32) -> bool {
         self.weights_at(x, y).is_some()
+    }
+}
+
+/// A convex polygon on the screen with positive area (the same edge functions, top-left rule
+/// and row crossings as a triangle): coverage without depth, for faces scan-converted whole (a
+/// face split into triangles pays each row once per triangle).
+#[derive(Debug, Clone)]
+pub(super) struct ScreenPolygon {
+    p: Vec<DVec2>,
+    top_left: Vec<bool>,
+    cross: Vec<(f64, f64, f64)>,
+    pub xmin: u32,
+    pub xmax: u32,
+    pub ymin: u32,
+    pub ymax: u32,
+}
+
+impl ConvexRows for ScreenPolygon {
+    convex_fields!();
+}
+
+/// Scan conversion by rows of a convex screen polygon (a triangle or a whole face): its
+/// vertices in order with positive area, each edge's top-left flag and where its line crosses
+/// a row's centre line.
+pub(super) trait ConvexRows {
+    /// The vertices, in order with positive area.
+    fn vertices(&self) -> &[DVec2];
+    /// Per edge `i -> i+1`: whether it is a top or left edge.
+    fn top_left(&self) -> &[bool];
+    /// Per edge `i -> i+1`: where its line crosses a row's centre line `yc`,
+    /// `x = cross[i].0 + cross[i].1 yc`, and whether the inside lies right of it (`1.0`), left
+    /// of it (`-1.0`) or the edge is horizontal (`0.0`).
+    fn crossings(&self) -> &[(f64, f64, f64)];
+    /// The first and last columns that may be covered.
+    fn x_range(&self) -> (u32, u32);
+
+    /// True when the centre of pixel `(x, y)` is covered (top-left rule).
+    fn covers(&self, x: u32, y: u32) -> bool {
+        let c = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+        let (p, top_left) = (self.vertices(), self.top_left());
+        (0..p.len()).all(|i| {
+            let e = edge(p[i], p[(i + 1) % p.len()], c);
+            e > 0.0 || (e == 0.0 && top_left[i])
+        })
     }
 
     /// The columns of row `y` that may be covered: the interval where every edge function is
     /// non-negative at the row's centre line, widened by a pixel on each side so that the exact
-    /// test ([`ScreenTriangle::covers`]) decides at the ends. `None` when the row misses.
-    pub fn row_candidates(&self, y: u32) -> Option<(u32, u32)> {
+    /// test ([`ConvexRows::covers`]) decides at the ends. `None` when the row misses.
+    fn row_candidates(&self, y: u32) -> Option<(u32, u32)> {
         let yc = y as f64 + 0.5;
-        let (mut lo, mut hi) = (self.xmin as f64, self.xmax as f64 + 1.0);
-        for (i, &(x0, slope, side)) in self.cross.iter().enumerate() {
+        let (xmin, xmax) = self.x_range();
+        let p = self.vertices();
+        let (mut lo, mut hi) = (xmin as f64, xmax as f64 + 1.0);
+        for (i, &(x0, slope, side)) in self.crossings().iter().enumerate() {
             // edge(a, b, (x, yc)) = (b.x - a.x)(yc - a.y) - (b.y - a.y)(x - a.x) >= 0: right of
             // the crossing when b.y < a.y, left of it when b.y > a.y.
             if side == 0.0 {
-                let (a, b) = (self.p[i], self.p[(i + 1) % 3]);
+                let (a, b) = (p[i], p[(i + 1) % p.len()]);
                 if (b.x - a.x) * (yc - a.y) < 0.0 {
                     return None;
                 }
@@ -92,24 +169,26 @@ impl ScreenTriangle {
                 hi = min_of(hi, x - 0.5);
             }
         }
-        let x0 = max_of(floor_f64(lo) - 1.0, self.xmin as f64);
-        let x1 = min_of(ceil_f64(hi) + 1.0, self.xmax as f64);
+        let x0 = max_of(floor_f64(lo) - 1.0, xmin as f64);
+        let x1 = min_of(ceil_f64(hi) + 1.0, xmax as f64);
         (x0 <= x1).then_some((x0 as u32, x1 as u32))
     }
 
     /// The covered pixels of row `y` as one run `x0..=x1` (`None` when none): exactly the pixels
-    /// [`ScreenTriangle::covers`] accepts. The run's ends come from where the edges cross the
+    /// [`ConvexRows::covers`] accepts. The run's ends come from where the edges cross the
     /// row's centre line; an end within the rounding of that crossing (or any end, on a row
     /// that a horizontal edge or a nearly horizontal one makes delicate) is settled by the
     /// exact test.
-    pub fn row_span(&self, y: u32) -> Option<(u32, u32)> {
+    fn row_span(&self, y: u32) -> Option<(u32, u32)> {
         let yc = y as f64 + 0.5;
+        let (xmin, xmax) = self.x_range();
+        let p = self.vertices();
         let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
         // Rounding of the crossings (a few units in the last place of their terms).
         let mut err = 0.0f64;
-        for (i, &(x0, slope, side)) in self.cross.iter().enumerate() {
+        for (i, &(x0, slope, side)) in self.crossings().iter().enumerate() {
             if side == 0.0 {
-                let (a, b) = (self.p[i], self.p[(i + 1) % 3]);
+                let (a, b) = (p[i], p[(i + 1) % p.len()]);
                 let c = (b.x - a.x) * (yc - a.y);
                 if c < 0.0 {
                     return None;
@@ -131,8 +210,8 @@ impl ScreenTriangle {
         if !(eps < 0.25) {
             return self.row_span_exact(y);
         }
-        let a = max_of(ceil_f64(lo - eps), self.xmin as f64);
-        let b = min_of(floor_f64(hi + eps), self.xmax as f64);
+        let a = max_of(ceil_f64(lo - eps), xmin as f64);
+        let b = min_of(floor_f64(hi + eps), xmax as f64);
         if !(a <= b) {
             return None;
         }
@@ -151,7 +230,7 @@ impl ScreenTriangle {
         (a <= b).then_some((a, b))
     }
 
-    /// [`ScreenTriangle::row_span`] by the exact test from the widened candidates.
+    /// [`ConvexRows::row_span`] by the exact test from the widened candidates.
     fn row_span_exact(&self, y: u32) -> Option<(u32, u32)> {
         let (mut x0, mut x1) = self.row_candidates(y)?;
         while x0 <= x1 && !self.covers(x0, y) {
@@ -162,27 +241,20 @@ impl ScreenTriangle {
         }
         (x0 <= x1 && self.covers(x1, y)).then_some((x0, x1))
     }
-
-    /// Linear depth at the centre of pixel `(x, y)` when covered.
-    pub fn depth_at_center(&self, x: u32, y: u32) -> Option<f32> {
-        let w = self.weights_at(x, y)?;
-        let (b0, b1, b2) = (w[0] / self.area, w[1] / self.area, w[2] / self.area);
-        let zi = b0 * self.z[0] + b1 * self.z[1] + b2 * self.z[2];
-        let d = if self.perspective { 1.0 / zi } else { zi };
-        let d = d as f32;
-        d.is_finite().then_some(d)
-    }
 }
 
-/// Clips a view-space triangle against the near plane and returns up to two screen triangles.
-pub(super) fn setup_triangle(v: [Vec3; 3], view: &RasterView) -> Vec<ScreenTriangle> {
+/// The part of the view-space convex polygon `v` in front of the near plane (Sutherland-Hodgman
+/// on one plane, in f64), projected to the screen: each vertex's position and depth term
+/// (`1/d` for perspective, `d` for orthographic). Empty when fewer than three vertices are
+/// left or a projected value is not finite.
+fn clip_and_project(v: &[Vec3], view: &RasterView) -> Vec<(DVec2, f64)> {
     let (l, r, b, t, near, persp) = view.extents();
-    // Depth d = -z; keep d >= near (Sutherland-Hodgman on one plane), in f64.
+    // Depth d = -z; keep d >= near.
     let pts: Vec<glam::DVec3> = v.iter().map(|p| p.as_dvec3()).collect();
     let near = near as f64;
-    let mut poly: Vec<glam::DVec3> = Vec::with_capacity(4);
-    for i in 0..3 {
-        let (a, c) = (pts[i], pts[(i + 1) % 3]);
+    let mut poly: Vec<glam::DVec3> = Vec::with_capacity(pts.len() + 1);
+    for i in 0..pts.len() {
+        let (a, c) = (pts[i], pts[(i + 1) % pts.len()]);
         let (da, dc) = (-a.z - near, -c.z - near);
         if da >= 0.0 {
             poly.push(a);
@@ -218,8 +290,42 @@ pub(super) fn setup_triangle(v: [Vec3; 3], view: &RasterView) -> Vec<ScreenTrian
     {
         return Vec::new();
     }
+    projected
+}
+
+/// The pixel bounds of the screen points `p` (pixel centres inside their box), `None` when no
+/// pixel centre of the `view` lies inside: `(xmin, xmax, ymin, ymax)`.
+fn pixel_bounds(p: &[DVec2], view: &RasterView) -> Option<(u32, u32, u32, u32)> {
+    let (w, h) = (view.width as f64, view.height as f64);
+    let lo = p.iter().fold(p[0], |m, q| m.min(*q));
+    let hi = p.iter().fold(p[0], |m, q| m.max(*q));
+    // Pixel centres x + 0.5 inside [lo, hi].
+    let xmin = (lo.x - 0.5).ceil().max(0.0);
+    let ymin = (lo.y - 0.5).ceil().max(0.0);
+    let xmax = (hi.x - 0.5).floor().min(w - 1.0);
+    let ymax = (hi.y - 0.5).floor().min(h - 1.0);
+    (xmin <= xmax && ymin <= ymax).then_some((xmin as u32, xmax as u32, ymin as u32, ymax as u32))
+}
+
+/// The top-left flag and the row crossing ([`ConvexRows::crossings`]) of edge `a -> c`.
+fn edge_rows(a: DVec2, c: DVec2) -> (bool, (f64, f64, f64)) {
+    let (dx, dy) = (c.x - a.x, c.y - a.y);
+    let top_left = (dy == 0.0 && dx > 0.0) || dy < 0.0;
+    let cross = if dy == 0.0 {
+        (0.0, 0.0, 0.0)
+    } else {
+        let slope = (c.x - a.x) / dy;
+        (a.x - slope * a.y, slope, if dy < 0.0 { 1.0 } else { -1.0 })
+    };
+    (top_left, cross)
+}
+
+/// Clips a view-space triangle against the near plane and returns up to two screen triangles.
+pub(super) fn setup_triangle(v: [Vec3; 3], view: &RasterView) -> Vec<ScreenTriangle> {
+    let persp = view.extents().5;
+    let projected = clip_and_project(&v, view);
     let mut out = Vec::with_capacity(2);
-    for i in 1..projected.len() - 1 {
+    for i in 1..projected.len().saturating_sub(1) {
         let mut tri = [projected[0], projected[i], projected[i + 1]];
         let mut area = edge(tri[0].0, tri[1].0, tri[2].0);
         if area == 0.0 {
@@ -230,43 +336,57 @@ pub(super) fn setup_triangle(v: [Vec3; 3], view: &RasterView) -> Vec<ScreenTrian
             area = -area;
         }
         let p = [tri[0].0, tri[1].0, tri[2].0];
-        let lo = p[0].min(p[1]).min(p[2]);
-        let hi = p[0].max(p[1]).max(p[2]);
-        // Pixel centres x + 0.5 inside [lo, hi].
-        let xmin = (lo.x - 0.5).ceil().max(0.0);
-        let ymin = (lo.y - 0.5).ceil().max(0.0);
-        let xmax = (hi.x - 0.5).floor().min(w - 1.0);
-        let ymax = (hi.y - 0.5).floor().min(h - 1.0);
-        if xmin > xmax || ymin > ymax {
+        let Some((xmin, xmax, ymin, ymax)) = pixel_bounds(&p, view) else {
             continue;
-        }
-        let top_left = std::array::from_fn(|i| {
-            let (a, c) = (p[i], p[(i + 1) % 3]);
-            let (dx, dy) = (c.x - a.x, c.y - a.y);
-            (dy == 0.0 && dx > 0.0) || dy < 0.0
-        });
-        let cross = std::array::from_fn(|i| {
-            let (a, c) = (p[i], p[(i + 1) % 3]);
-            let dy = c.y - a.y;
-            if dy == 0.0 {
-                (0.0, 0.0, 0.0)
-            } else {
-                let slope = (c.x - a.x) / dy;
-                (a.x - slope * a.y, slope, if dy < 0.0 { 1.0 } else { -1.0 })
-            }
-        });
+        };
+        let rows: [(bool, (f64, f64, f64)); 3] =
+            std::array::from_fn(|i| edge_rows(p[i], p[(i + 1) % 3]));
         out.push(ScreenTriangle {
             p,
             z: [tri[0].1, tri[1].1, tri[2].1],
             perspective: persp,
             area,
-            top_left,
-            cross,
-            xmin: xmin as u32,
-            xmax: xmax as u32,
-            ymin: ymin as u32,
-            ymax: ymax as u32,
+            top_left: rows.map(|r| r.0),
+            cross: rows.map(|r| r.1),
+            xmin,
+            xmax,
+            ymin,
+            ymax,
         });
     }
     out
+}
+
+/// Clips a view-space convex planar polygon against the near plane and sets it up whole, its
+/// vertices in order with positive area (the order of [`setup_triangle`]'s triangles for the
+/// same outline). `None` when nothing of it is left or its screen area is zero.
+pub(super) fn setup_polygon(v: &[Vec3], view: &RasterView) -> Option<ScreenPolygon> {
+    let projected = clip_and_project(v, view);
+    let mut p: Vec<DVec2> = projected.iter().map(|q| q.0).collect();
+    if p.len() < 3 {
+        return None;
+    }
+    // Twice the signed area, from the fan of the first vertex (each term is a triangle's
+    // `edge`).
+    let area: f64 = (1..p.len() - 1).map(|i| edge(p[0], p[i], p[i + 1])).sum();
+    if !(area != 0.0) {
+        return None;
+    }
+    if area < 0.0 {
+        // The first vertex stays first, as in a triangle whose last two are swapped.
+        p[1..].reverse();
+    }
+    let (xmin, xmax, ymin, ymax) = pixel_bounds(&p, view)?;
+    let (top_left, cross) = (0..p.len())
+        .map(|i| edge_rows(p[i], p[(i + 1) % p.len()]))
+        .unzip();
+    Some(ScreenPolygon {
+        p,
+        top_left,
+        cross,
+        xmin,
+        xmax,
+        ymin,
+        ymax,
+    })
 }
