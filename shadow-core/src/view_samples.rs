@@ -184,9 +184,29 @@ impl ViewSamples {
         self.triangle.iter().filter(|&&t| t != NO_TRIANGLE).count()
     }
     /// The sample of pixel `i`, `None` for background.
+    #[inline]
     pub fn get(&self, i: usize) -> Option<ViewSample> {
+        self.sample_at(i, UVec2::new(i as u32 % self.width, i as u32 / self.width))
+    }
+    /// The sample of the pixel at column `x` and row `y` (`x` below the width), `None` for
+    /// background: [`ViewSamples::get`] for callers that walk rows, without the division that
+    /// recovers the coordinates from the index.
+    #[inline]
+    pub fn get_at(&self, x: u32, y: u32) -> Option<ViewSample> {
+        debug_assert!(
+            x < self.width,
+            "column {x} outside a width of {}",
+            self.width
+        );
+        self.sample_at(
+            y as usize * self.width as usize + x as usize,
+            UVec2::new(x, y),
+        )
+    }
+    #[inline]
+    fn sample_at(&self, i: usize, pixel: UVec2) -> Option<ViewSample> {
         self.is_valid(i).then(|| ViewSample {
-            pixel: UVec2::new(i as u32 % self.width, i as u32 / self.width),
+            pixel,
             position: self.position[i],
             geometric_normal: self.geometric_normal[i],
             shading_normal: self.shading_normal[i],

@@ -17,6 +17,16 @@ fn every_builtin_scene_renders_view_samples() {
             "{name}: {} valid pixels",
             view.valid_count()
         );
+        // By index and by column and row: the same samples, at their own pixel.
+        for y in 0..48u32 {
+            for x in 0..64u32 {
+                let by_index = view.get((y * 64 + x) as usize);
+                assert_eq!(view.get_at(x, y), by_index, "{name} ({x}, {y})");
+                if let Some(s) = by_index {
+                    assert_eq!(s.pixel, glam::UVec2::new(x, y));
+                }
+            }
+        }
     }
     assert!(
         builtin("nope")

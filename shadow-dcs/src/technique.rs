@@ -437,7 +437,7 @@ impl Dcs {
         let w = view.width() as usize;
         for (j, x, y) in pairs.pixels() {
             let i = y as usize * w + x as usize;
-            let Some(s) = view.get(i) else { continue };
+            let Some(s) = view.get_at(x, y) else { continue };
             let (entries, tests) = pairs.of(j);
             let class = self.pixel(p, f, i, &s, entries, tests, scratch, counts);
             visit(i, &s, class, scratch);

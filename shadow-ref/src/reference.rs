@@ -372,7 +372,7 @@ impl Reference {
             let (mut units, mut samples, mut scratch) =
                 (Vec::new(), Vec::new(), Scratch::default());
             for (x, px) in line.iter_mut().enumerate() {
-                let Some(s) = view.get(row * w + x) else {
+                let Some(s) = view.get_at(x as u32, row as u32) else {
                     continue;
                 };
                 self.pixel_samples(p.light.as_ref(), s.pixel, &mut units, &mut samples);
@@ -537,7 +537,7 @@ impl ShadowTechnique for Reference {
                     let (mut units, mut samples, mut scratch) =
                         (Vec::new(), Vec::new(), Scratch::default());
                     for x in 0..w {
-                        let Some(s) = view.get(row * w + x) else {
+                        let Some(s) = view.get_at(x as u32, row as u32) else {
                             continue;
                         };
                         let rb = self.receiver_beam(p, &s, n as usize, &mut scratch);
