@@ -605,23 +605,20 @@ mod tests {
             out.extend((x0..=x1).map(|x| (x, y)));
         });
         out.sort_unstable();
-        let tested: Vec<(u32, u32)> = (0..view.height)
+        let mut tested: Vec<(u32, u32)> = (0..view.height)
             .flat_map(|y| (0..view.width).map(move |x| (x, y)))
             .filter(|&(x, y)| cover.covers(x, y))
-            .collect::<std::collections::BTreeSet<_>>()
-            .into_iter()
             .collect();
-        let mut sorted = tested.clone();
-        sorted.sort_unstable();
-        assert_eq!(out, sorted, "runs and the pixel test of {outline:?}");
+        tested.sort_unstable();
+        assert_eq!(out, tested, "runs and the pixel test of {outline:?}");
         out
     }
 
     /// A whole convex polygon covers the pixels of its fan triangles, each once: random
     /// planar quads and pentagons in perspective (some crossing the near plane, some thin), and
     /// quads with vertices on the half-pixel grid, whose pixel centres lie on edges (the
-    /// top-left rule settles them as for the triangles). Two quads sharing an edge cover each
-    /// pixel of their union once.
+    /// top-left rule settles them as for the triangles). Such a quad and a triangle sharing one of
+    /// its edges cover each pixel of their union once.
     #[test]
     fn covered_polygons_equal_their_fan_triangles() {
         let persp = persp_view();

@@ -96,6 +96,8 @@ macro_rules! convex_fields {
 
 impl ConvexRows for ScreenTriangle {
     convex_fields!();
+    /// The pixels that have a depth ([`ScreenTriangle::depth_at_center`]): the same rule as
+    /// the default, from the same weights.
     fn covers(&self, x: u32, y: u32) -> bool {
         self.weights_at(x, y).is_some()
     }
