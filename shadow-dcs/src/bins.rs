@@ -230,11 +230,11 @@ impl ScanWedge {
 /// and three sums, as a plane on four view samples is.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Boxes {
-    /// Per axis, the lower bounds, four boxes to a vector (fixed arrays: a plane's pick of
-    /// bounds is then one pointer per axis, and indices below [`Boxes::quads`] need no check).
-    lo: [[Vec4; BOXES / 4]; 3],
-    /// Per axis, the upper bounds, in the same layout.
-    hi: [[Vec4; BOXES / 4]; 3],
+    /// Per axis, the upper bounds (`[k][0]`) and the lower ones (`[k][1]`), four boxes to a
+    /// vector (fixed arrays: a plane's pick of bounds is then one pointer per axis, indexed by
+    /// the sign bit of the normal's component, and indices below [`Boxes::quads`] need no
+    /// check).
+    bounds: [[[Vec4; BOXES / 4]; 2]; 3],
     /// Vectors in use.
     quads: usize,
     /// The boxes that exist (one bit each).
@@ -251,7 +251,7 @@ impl Boxes {
             let (q, lane) = (i / 4, i % 4);
             if lane == 0 {
                 // A new vector of four boxes, none yet.
-                for v in self.lo.iter_mut().chain(self.hi.iter_mut()) {
+                for v in self.bounds.iter_mut().flatten() {
                     v[q] = Vec4::ZERO;
                 }
                 self.quads = q + 1;
@@ -264,8 +264,8 @@ impl Boxes {
                 let h = h + (m.abs() + h) * BOX_PAD;
                 let (lo, hi) = (m - h, m + h);
                 for k in 0..3 {
-                    self.lo[k][q][lane] = lo[k];
-                    self.hi[k][q][lane] = hi[k];
+                    self.bounds[k][0][q][lane] = hi[k];
+                    self.bounds[k][1][q][lane] = lo[k];
                 }
                 self.valid |= 1 << i;
             }
@@ -276,9 +276,11 @@ impl Boxes {
     /// values) and at the nearest ones (its smallest).
     #[inline(always)]
     fn corners(&self, n: Vec4) -> Corners<'_> {
+        // The sign bit picks the bounds without a comparison (a zero or NaN component may
+        // take either: its products are zero or NaN at both).
         let pick = |k: usize, c: f32| {
-            let (lo, hi) = (&self.lo[k], &self.hi[k]);
-            if c >= 0.0 { (hi, lo) } else { (lo, hi) }
+            let neg = (c.to_bits() >> 31) as usize;
+            (&self.bounds[k][neg], &self.bounds[k][neg ^ 1])
         };
         let ((fx, nx), (fy, ny), (fz, nz)) = (pick(0, n.x), pick(1, n.y), pick(2, n.z));
         ([fx, fy, fz], [nx, ny, nz])
