@@ -1072,6 +1072,76 @@ mod tests {
         );
     }
 
+    /// A box test keeps exactly the boxes that reach the positive side of a plane (up to the
+    /// boxes' padding): the plane's largest value over a box, at the corner its normal's signs
+    /// pick, against the largest of the eight corners in double precision. Normal components of
+    /// `0.0` and `-0.0` (whose sign bit picks the other bound) are among the planes. Fails when
+    /// the pick takes the nearest corner instead of the farthest.
+    #[test]
+    fn box_tests_keep_the_boxes_a_plane_reaches() {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut rand = move || {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let (mut kept, mut rejected) = (0, 0);
+        for round in 0..300 {
+            let boxes: Vec<ViewBox> = (0..16)
+                .map(|_| {
+                    let c = Vec3::new(rand(), rand(), rand()) * 2.0 - 1.0;
+                    let h = Vec3::new(rand(), rand(), rand()) * 0.3;
+                    Some((c - h, c + h))
+                })
+                .collect();
+            let mut b = Boxes::default();
+            b.set(boxes.iter().copied());
+            let mut n = Vec3::new(rand(), rand(), rand()) * 2.0 - 1.0;
+            // Some components exactly zero, of either sign.
+            for k in 0..3 {
+                match (round + k) % 5 {
+                    0 => n[k] = 0.0,
+                    1 => n[k] = -0.0,
+                    _ => {}
+                }
+            }
+            let plane = n.extend(rand() * 2.0 - 1.0);
+            let mut planes = [OPEN; BOX_PLANES];
+            planes[0] = plane;
+            let w = ScanWedge {
+                planes,
+                fold: [OPEN, OPEN],
+                used: 1,
+                edge: 0,
+                weight: None,
+                planar: None,
+                cut: PlaneGroups::new(&planes),
+            };
+            let mask = b.test(&w, 0.0);
+            for (i, bx) in boxes.iter().enumerate() {
+                let (lo, hi) = bx.unwrap();
+                let largest = (0..8)
+                    .map(|c| {
+                        let pick = |k: usize| if c >> k & 1 == 1 { hi[k] } else { lo[k] };
+                        let x = DVec3::new(pick(0).into(), pick(1).into(), pick(2).into());
+                        plane.truncate().as_dvec3().dot(x) + f64::from(plane.w)
+                    })
+                    .fold(f64::NEG_INFINITY, f64::max);
+                let keeps = mask >> i & 1 == 1;
+                if largest >= 0.0 {
+                    assert!(keeps, "round {round}, box {i}: {bx:?} reaches {plane:?}");
+                    kept += 1;
+                } else if largest < -1e-4 {
+                    assert!(!keeps, "round {round}, box {i}: {bx:?} misses {plane:?}");
+                    rejected += 1;
+                }
+            }
+        }
+        assert!(
+            kept > 500 && rejected > 500,
+            "{kept} kept, {rejected} rejected"
+        );
+    }
+
     /// The box hierarchy finds exactly the (pixel, wedge, weight) pairs of a brute-force scan
     /// of every view sample against every wedge (inside the bounding planes, non-zero exact
     /// weight): no box test drops a pair.
