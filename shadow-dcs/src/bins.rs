@@ -1004,16 +1004,20 @@ mod tests {
         );
     }
 
+    /// Uniform values in `[0, 1)` from a linear congruential sequence started at `seed`.
+    fn uniform(mut seed: u64) -> impl FnMut() -> f32 {
+        move || {
+            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
     /// A plane that [`ScanWedge::cut_planes`] leaves out is positive at every view sample of
     /// the tile, far from the origin and with planes through a view sample (value zero up to
     /// rounding); planes well clear of the box are left out.
     #[test]
     fn planes_left_out_of_a_tile_reject_none_of_its_view_samples() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut rand = move || {
-            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rand = uniform(0x9e37_79b9_7f4a_7c15u64);
         let (mut left_out, mut kept) = (0, 0);
         for round in 0..400 {
             let scale = [1e-3f32, 1.0, 1e3][round % 3];
@@ -1079,11 +1083,7 @@ mod tests {
     /// the pick takes the nearest corner instead of the farthest.
     #[test]
     fn box_tests_keep_the_boxes_a_plane_reaches() {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut rand = move || {
-            seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rand = uniform(0x2545_f491_4f6c_dd1du64);
         let (mut kept, mut rejected) = (0, 0);
         for round in 0..300 {
             let boxes: Vec<ViewBox> = (0..16)
