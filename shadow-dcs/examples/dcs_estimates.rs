@@ -5,12 +5,15 @@
 //!
 //!     cargo run --release -p shadow-dcs --example dcs_estimates -- [SCENE] [SIZE] [TECHNIQUE] [RUNS]
 //!
-//! `TECHNIQUE` is a DCS preset name (`dcs-64` by default) or `reference` (the reference on the
-//! samples of `dcs-64`: 64 stratified samples, seed 1, as `dcs_bench` compares them). Prints the
+//! `TECHNIQUE` is a DCS preset name (`dcs-64` by default), `reference` (the reference on the
+//! samples of `dcs-64`: 64 stratified samples, seed 1, as `dcs_bench` compares them), or
+//! `stratified-N` / `reference-N` (the `dcs-64` configuration with `N` stratified samples, and
+//! the reference on the same samples, as `dcs_bench SCENE SIZE N` compares them). Prints the
 //! best wall time of the runs and, for a DCS preset, the counters of the last one, which tell
 //! two builds apart when they should do the same work (pairs, covered updates).
 
 use shadow_core::prelude::*;
+use shadow_dcs::Dcs;
 use shadow_ref::Reference;
 
 mod common;
@@ -22,12 +25,26 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let name = args.get(2).map_or("dcs-64", String::as_str);
     let runs: u32 = args.get(3).map_or(Ok(1), |s| s.parse())?;
     let (setup, view) = common::scene_and_view(scene, size)?;
-    let mut technique: Box<dyn ShadowTechnique> = if name == "reference" {
-        let sampler = LightSampler::new(SamplingStrategy::Stratified, 64, 1)?;
-        Box::new(Reference::same_samples(sampler))
-    } else {
-        (common::preset(name, "`reference`")?.make)(1)
+    let count = |prefix: &str| -> Result<Option<u32>, String> {
+        name.strip_prefix(prefix)
+            .map(|n| n.parse().map_err(|_| format!("{name}: not {prefix}N")))
+            .transpose()
     };
+    let mut technique: Box<dyn ShadowTechnique> =
+        match (count("reference-")?, count("stratified-")?) {
+            (Some(n), _) => {
+                let sampler = LightSampler::new(SamplingStrategy::Stratified, n, 1)?;
+                Box::new(Reference::same_samples(sampler))
+            }
+            (None, Some(n)) => Box::new(Dcs::new(n, SamplingStrategy::Stratified, 1)?),
+            (None, None) if name == "reference" => {
+                let sampler = LightSampler::new(SamplingStrategy::Stratified, 64, 1)?;
+                Box::new(Reference::same_samples(sampler))
+            }
+            (None, None) => {
+                (common::preset(name, "`reference`, `reference-N` or `stratified-N`")?.make)(1)
+            }
+        };
     technique.prepare(setup.scene.clone(), setup.lights[0].clone())?;
     let (best, last) = common::best_of(runs, technique.as_mut(), &view)?;
     match last {

@@ -216,18 +216,22 @@ pub(crate) struct PlanarSamples {
 }
 
 impl PlanarSamples {
-    /// The first 64 samples' in-plane `x` (the first word).
+    /// The first `64 W` samples' in-plane `x`, a word at a time.
     #[inline]
-    pub fn first_word_x(&self) -> &[f32; 64] {
-        self.x[..64]
-            .try_into()
-            .expect("samples are padded to whole words")
+    pub fn words_x<const W: usize>(&self) -> &[[f32; 64]; W] {
+        Self::words(&self.x)
     }
 
-    /// The first 64 samples' in-plane `y`.
+    /// The first `64 W` samples' in-plane `y`, a word at a time.
     #[inline]
-    pub fn first_word_y(&self) -> &[f32; 64] {
-        self.y[..64]
+    pub fn words_y<const W: usize>(&self) -> &[[f32; 64]; W] {
+        Self::words(&self.y)
+    }
+
+    #[inline(always)]
+    fn words<const W: usize>(v: &[f32]) -> &[[f32; 64]; W] {
+        let (words, _) = v.as_chunks::<64>();
+        words[..W]
             .try_into()
             .expect("samples are padded to whole words")
     }

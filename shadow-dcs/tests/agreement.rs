@@ -186,6 +186,26 @@ fn remaining_disagreements_are_numerical_ties() {
     assert!(differ as f64 <= 1e-3 * pairs as f64, "{differ} of {pairs}");
 }
 
+/// Every number of sample words the per-pixel pass handles its own way agrees with the
+/// reference on the same samples: one word, two to four (fixed-size words of the angular
+/// index and the light-plane test, one of them with a partly used last word) and five (words
+/// of any length).
+#[test]
+fn every_number_of_sample_words_agrees_with_the_reference() {
+    let setup = shadow_core::scenes::builtin("bunny").unwrap();
+    let view = view_of(&setup, 40, 30);
+    for n in [64, 100, 192, 256, 320] {
+        let mut dcs = Dcs::new(n, SamplingStrategy::Stratified, 6).unwrap();
+        let mut r = same_samples_reference(&dcs);
+        let (d, e) = (run(&mut dcs, &setup, &view), run(&mut r, &setup, &view));
+        let m = shadow_core::metrics::compare(&d.visibility, &e.visibility).unwrap();
+        assert!(m.sample_agreement.unwrap() >= 0.9999, "{n} samples: {m:?}");
+        // The pixels took per-sample work, through the light-plane test.
+        assert!(d.stats.counter("pixels-per-sample") > 50, "{n} samples");
+        assert!(d.stats.counter("covered-updates") > 500, "{n} samples");
+    }
+}
+
 #[test]
 fn concave_polygon_lights_and_every_sampling_strategy_agree_with_the_reference() {
     let setup = shadow_core::scenes::builtin("bunny").unwrap();
