@@ -131,8 +131,11 @@ fn spread_table<const W: usize>(prefix: &mut [u64], hits: &mut [u64], buckets: &
     let h: &mut [[u64; W]; BUCKETS] = (&mut h[..BUCKETS])
         .try_into()
         .expect("the hit table has BUCKETS rows");
-    for (k, b) in buckets.iter().enumerate() {
-        h[(*b as usize).min(BUCKETS - 1)][(k / 64).min(W - 1)] |= 1 << (k & 63);
+    for (w, word) in buckets.chunks(64).enumerate() {
+        let w = w.min(W - 1);
+        for (k, b) in word.iter().enumerate() {
+            h[(*b as usize).min(BUCKETS - 1)][w] |= 1 << (k & 63);
+        }
     }
     let mut acc = [0u64; W];
     table[0] = acc;
@@ -142,8 +145,11 @@ fn spread_table<const W: usize>(prefix: &mut [u64], hits: &mut [u64], buckets: &
         }
         *row = acc;
     }
-    for b in buckets {
-        h[(*b as usize).min(BUCKETS - 1)] = [0; W];
+    for (w, word) in buckets.chunks(64).enumerate() {
+        let w = w.min(W - 1);
+        for b in word {
+            h[(*b as usize).min(BUCKETS - 1)][w] = 0;
+        }
     }
 }
 

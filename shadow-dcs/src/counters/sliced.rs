@@ -73,10 +73,39 @@ impl Counters for BitSliced {
     fn sub_one(&mut self, mask: u64, k: u64) -> Result<(), OutOfRange> {
         self.update_word(0, mask, k, sub_step)
     }
+
+    /// Word by word: the words' counters are independent, so each word takes its outer
+    /// updates, then its inner ones, with its bit words at hand and no loop over the words
+    /// per update (at 256 samples on `bunny`, update by update over all the words cost 80 M
+    /// instructions more: 3022 M against 2942 M).
+    fn apply(&mut self, words: usize, masks: &[u64], weights: &[i64]) -> Result<(), OutOfRange> {
+        let top = super::lane_max(self.bits);
+        if weights.iter().any(|k| k.unsigned_abs() > top) {
+            return Err(OutOfRange);
+        }
+        let n_words = self.n.div_ceil(64).min(words);
+        for w in 0..n_words {
+            let cut = valid(self.n, w);
+            let updates = masks.chunks_exact(words).zip(weights);
+            for (m, &k) in updates.clone() {
+                if k > 0 {
+                    self.ripple(w, m[w] & cut, k as u64, add_step)?;
+                }
+            }
+            for (m, &k) in updates {
+                if k < 0 {
+                    self.ripple(w, m[w] & cut, k.unsigned_abs(), sub_step)?;
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 impl BitSliced {
-    /// Adds or subtracts `k` times the samples of `mask`, word by word.
+    /// Adds or subtracts `k` times the samples of `mask`, word by word: the weight checked
+    /// once, and only the last word cut to the samples that exist (at 256 samples, checking
+    /// and cutting every word cost `bunny` 48 M instructions).
     #[inline]
     fn update(
         &mut self,
@@ -84,16 +113,23 @@ impl BitSliced {
         k: u64,
         step: impl Fn(u64, u64) -> (u64, u64) + Copy,
     ) -> Result<(), OutOfRange> {
-        for (w, &m) in mask.iter().enumerate().take(self.n.div_ceil(64)) {
-            self.update_word(w, m, k, step)?;
+        if k > super::lane_max(self.bits) {
+            return Err(OutOfRange);
+        }
+        let words = self.n.div_ceil(64);
+        for (w, &m) in mask.iter().enumerate().take(words) {
+            let m = if w + 1 == words {
+                m & valid(self.n, w)
+            } else {
+                m
+            };
+            self.ripple(w, m, k, step)?;
         }
         Ok(())
     }
 
-    /// Adds or subtracts (`step(bit word, carry) -> (new word, carry out)`) `k` times the
-    /// samples `m` of word `w`: for each set bit `b` of `k`, a ripple from bit word `b` up.
-    /// Stops at the first carry out of the top bit; the counters are then partly updated, and
-    /// the caller starts the pixel again.
+    /// [`BitSliced::ripple`] with the weight checked and the word cut to the samples that
+    /// exist.
     #[inline(always)]
     fn update_word(
         &mut self,
@@ -105,7 +141,21 @@ impl BitSliced {
         if k > super::lane_max(self.bits) {
             return Err(OutOfRange);
         }
-        let m = m & valid(self.n, w);
+        self.ripple(w, m & valid(self.n, w), k, step)
+    }
+
+    /// Adds or subtracts (`step(bit word, carry) -> (new word, carry out)`) `k` (at most the
+    /// counters' largest value) times the samples `m` (existing ones) of word `w`: for each
+    /// set bit `b` of `k`, a ripple from bit word `b` up. Stops at the first carry out of the
+    /// top bit; the counters are then partly updated, and the caller starts the pixel again.
+    #[inline(always)]
+    fn ripple(
+        &mut self,
+        w: usize,
+        m: u64,
+        k: u64,
+        step: impl Fn(u64, u64) -> (u64, u64),
+    ) -> Result<(), OutOfRange> {
         if m == 0 {
             return Ok(());
         }
