@@ -522,6 +522,10 @@ impl BlockWedges {
     /// against the boxes of its clusters of [`CLUSTER`] x [`CLUSTER`] pixels, then those a
     /// cluster keeps against its squares' boxes. Returns each square's wedges (silhouette
     /// indices in order) and the number of wedges the block kept.
+    ///
+    /// The block's wedges are tested [`LIST_CHUNK`] at a time in parallel and the chunks'
+    /// lists joined in order: a block holding much of the penumbra keeps thousands of wedges,
+    /// and testing them on one thread left the other idle at the end of the frame.
     pub fn square_lists(
         &self,
         input: &ScanInput,
@@ -530,25 +534,41 @@ impl BlockWedges {
     ) -> (Vec<Vec<u32>>, usize) {
         let (g, bit) = (block / BOXES, block % BOXES);
         let clusters = Clusters::new(squares, &self.square_boxes[block]);
-        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); squares.len()];
-        let mut kept = 0;
-        for wi in 0..input.wedges.len() {
-            if self.masks[wi * self.groups + g] >> bit & 1 == 0 {
-                continue;
+        let kept: Vec<u32> = (0..input.wedges.len() as u32)
+            .filter(|&wi| self.masks[wi as usize * self.groups + g] >> bit & 1 == 1)
+            .collect();
+        let chunk_lists = |chunk: &[u32]| {
+            let mut lists: Vec<Vec<u32>> = vec![Vec::new(); squares.len()];
+            for &wi in chunk {
+                let w = &input.wedges[wi as usize];
+                let live = clusters.boxes.test(w, input.slack);
+                if live == 0 {
+                    continue;
+                }
+                for slot in bits_of(clusters.squares.test_quads(w, input.slack, live)) {
+                    lists[clusters.slots[slot]].push(wi);
+                }
             }
-            kept += 1;
-            let w = &input.wedges[wi];
-            let live = clusters.boxes.test(w, input.slack);
-            if live == 0 {
-                continue;
-            }
-            for slot in bits_of(clusters.squares.test_quads(w, input.slack, live)) {
-                lists[clusters.slots[slot]].push(wi as u32);
+            lists
+        };
+        if kept.len() <= LIST_CHUNK {
+            return (chunk_lists(&kept), kept.len());
+        }
+        let parts: Vec<Vec<Vec<u32>>> = kept.par_chunks(LIST_CHUNK).map(chunk_lists).collect();
+        let mut lists: Vec<Vec<u32>> = (0..squares.len())
+            .map(|s| Vec::with_capacity(parts.iter().map(|p| p[s].len()).sum()))
+            .collect();
+        for part in &parts {
+            for (l, p) in lists.iter_mut().zip(part) {
+                l.extend_from_slice(p);
             }
         }
-        (lists, kept)
+        (lists, kept.len())
     }
 }
+
+/// Wedges per parallel task of [`BlockWedges::square_lists`].
+const LIST_CHUNK: usize = 1024;
 
 /// Side of a cluster of squares, in pixels: the level between blocks and squares.
 const CLUSTER: u32 = 2 * SQUARE;
@@ -1184,10 +1204,17 @@ mod tests {
             let blocks = blocks(w, h);
             let levels = BlockWedges::new(&input, &blocks);
             let mut found = Vec::new();
+            let mut chunked = false;
             let (mut pairs, mut scratch) = (SquarePairs::default(), SquareScratch::default());
             for (bi, (_, squares)) in blocks.iter().enumerate() {
-                let (lists, _) = levels.square_lists(&input, bi, squares);
+                let (lists, kept) = levels.square_lists(&input, bi, squares);
+                // `bunny` keeps wedges enough for several parallel chunks, joined in order.
+                chunked |= kept > LIST_CHUNK;
                 for (r, list) in squares.iter().zip(&lists) {
+                    assert!(
+                        list.is_sorted_by(|a, b| a < b),
+                        "a square's wedges in order"
+                    );
                     square_pairs(&input, list, *r, &mut pairs, &mut scratch);
                     for (j, x, y) in pairs.pixels() {
                         let i = (y * w + x) as usize;
@@ -1217,6 +1244,10 @@ mod tests {
             want.sort_unstable();
             assert!(want.len() > 500, "{name}: {} pairs", want.len());
             assert_eq!(found, want, "{name}");
+            assert!(
+                chunked || name != "bunny",
+                "bunny's block in parallel chunks"
+            );
         }
     }
 }

@@ -86,23 +86,24 @@ pub(crate) fn integration_constants(
 ) -> (Vec<i64>, u64) {
     let cd = c.as_dvec3();
     let eyed = eye.as_dvec3();
-    let reach = origins
-        .iter()
+    // The farthest view sample from the centre and the box around the eye and the view
+    // samples, in one parallel pass.
+    let (reach, (lo, hi)) = origins
+        .par_iter()
         .zip(valid)
         .filter(|(_, v)| **v)
-        .map(|(p, _)| (p.as_dvec3() - cd).length())
-        .fold((eyed - cd).length(), f64::max);
+        .map(|(p, _)| {
+            let p = p.as_dvec3();
+            ((p - cd).length(), (p, p))
+        })
+        .reduce(
+            || ((eyed - cd).length(), (eyed, eyed)),
+            |(r1, (lo1, hi1)), (r2, (lo2, hi2))| (r1.max(r2), (lo1.min(lo2), hi1.max(hi2))),
+        );
     let far_radius = reach * FAR_FACTOR;
     // Every crossing that counts lies on a segment from the eye to a view sample, so inside the
     // box around the eye and the view samples: quads are clipped to it (with a margin that keeps
     // counted crossings away from the cut).
-    let (lo, hi) = origins
-        .iter()
-        .zip(valid)
-        .filter(|(_, v)| **v)
-        .fold((eyed, eyed), |(lo, hi), (p, _)| {
-            (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
-        });
     let margin = DVec3::splat((hi - lo).length() * 1e-3 + 1e-9 * reach.max(1.0));
     let (lo, hi) = (lo - margin, hi + margin);
     // The quads with a non-zero weight, seen from the eye, clipped to the box.
@@ -206,7 +207,7 @@ pub(crate) fn integration_constants(
             }
         });
     let out = sums
-        .into_iter()
+        .into_par_iter()
         .zip(valid)
         .map(|(s, v)| if *v { s + eye_constant } else { 0 })
         .collect();
