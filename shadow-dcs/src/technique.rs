@@ -1204,11 +1204,10 @@ impl Dcs {
     }
 }
 
-/// The samples of `positions` above the tangent plane both from the surface point and from the
-/// offset `origin` (the reference's rule), one bit each, into `above`.
-/// Copies each square's values (`values` of each of `squares`, `per_pixel` of them per pixel, row by row within the square)
-/// into `out`, the image's values (`width` pixels a row), bands of [`SQUARE`] rows in
-/// parallel. Nothing is copied when `out` is empty (an output not asked for).
+/// Copies each square's values (`values` of each of `squares`, `per_pixel` of them per pixel,
+/// row by row within the square) into `out`, the image's values (`width` pixels a row), bands
+/// of [`SQUARE`] rows in parallel. Nothing is copied when `out` is empty (an output not asked
+/// for).
 fn scatter_squares<T: Copy + Send + Sync, R: Sync>(
     out: &mut [T],
     per_pixel: usize,
@@ -1240,6 +1239,8 @@ fn scatter_squares<T: Copy + Send + Sync, R: Sync>(
         });
 }
 
+/// The samples of `positions` above the tangent plane both from the surface point and from the
+/// offset `origin` (the reference's rule), one bit each, into `above`.
 fn horizon_mask_into(positions: &[Vec3], s: &ViewSample, origin: Vec3, above: &mut Vec<u64>) {
     above.clear();
     above.resize(positions.len().div_ceil(64), 0);
