@@ -46,8 +46,13 @@ pub(crate) const BLOCK: u32 = 128;
 pub(crate) const SQUARE: u32 = 16;
 
 /// Bounding planes per wedge in the box tests: more are dropped (any subset of a wedge's
-/// bounding planes bounds it).
-const BOX_PLANES: usize = 10;
+/// bounding planes bounds it). Eight fill two groups of four ([`PlaneGroup`]). The built-in
+/// scenes' wedges have 4 to 9 planes (`bunny`: 2,410 with 4, 25,620 with 6, 3 with 8, 2 with
+/// 9; `quad-over-plane` and `overlapping-occluders` 8 or 9); with 8 rather than 10 the tile
+/// candidates, pairs and covered updates are the same on every built-in scene, and a wedge
+/// takes 448 bytes instead of 512 (`bunny` `dcs-64`: 1784 M -> 1770 M instructions, simulated
+/// last-level misses 2,516 k -> 2,207 k, wall time 5% lower).
+const BOX_PLANES: usize = 8;
 
 /// Relative padding of a box, far above the rounding of its centre and of a plane evaluated there.
 const BOX_PAD: f32 = 1e-6;
@@ -57,8 +62,9 @@ pub(crate) const BOXES: usize = 64;
 
 /// A plane for box tests: `n.x`, `n.y`, `n.z`, `d`; the tests take the absolute values of `n`
 /// themselves. Four floats rather than seven keep a wedge's box-test data (its count, fold
-/// planes and planes, at the front of [`ScanWedge`]) within 208 bytes instead of 344: a box
-/// test waits mostly on its first loads of the wedge (`perf`).
+/// planes and bounding planes, at the front of [`ScanWedge`]) within 176 bytes (208 with ten
+/// bounding planes, 344 with seven floats each): a box test waits mostly on its first loads of
+/// the wedge (`perf`).
 type BoxPlane = Vec4;
 
 /// The plane every box passes (`0 . x + 1 >= 0`): unused plane slots.
@@ -70,11 +76,17 @@ const OPEN: BoxPlane = Vec4::new(0.0, 0.0, 0.0, 1.0);
 /// signs, and its edge prepared for the light-plane test.
 ///
 /// Laid out in declaration order (`repr(C)`) on cache-line boundaries, so that a box test's
-/// data (the count, the fold planes, then the bounding planes in use) fills the wedge's first
-/// lines: up to nine planes in three lines. Left to the compiler, the fields were reordered
-/// (the tile data first, the count after the weight), and a box test touched five lines of 656
-/// bytes; in declaration order `bunny`'s simulated last-level misses fell by 10% (3,029 k to
-/// 2,729 k), with no change in wall time measured.
+/// data (the count, the fold planes, then the groups of bounding planes in use) fills the
+/// wedge's first lines: up to eight planes in three lines. Left to the compiler, the fields
+/// were reordered (the tile data first, the count after the weight), and a box test touched
+/// five lines of 656 bytes; in declaration order `bunny`'s simulated last-level misses fell by
+/// 10% (3,029 k to 2,729 k), with no change in wall time measured. The bounding planes are
+/// kept once, four to a group in structure-of-arrays form, which both the box tests (one plane
+/// at a time) and [`ScanWedge::cut_planes`] (a group at a time) read. With a second copy in
+/// plane-by-plane form a wedge took 704 bytes; one copy took it to 512 and `bunny` `dcs-64`
+/// from 0.138 s to 0.118 s on two threads (`scripts/dcs_ab.sh`, 8 rounds; 0.262 s to 0.219 s
+/// on one), for the same instructions (1786 M -> 1784 M) and 4% fewer simulated L1 misses:
+/// the smaller records are what a square's wedges keep in the caches.
 #[derive(Debug, Clone, Copy)]
 #[repr(C, align(64))]
 pub(crate) struct ScanWedge {
@@ -83,11 +95,9 @@ pub(crate) struct ScanWedge {
     /// The scene edge.
     edge: u32,
     fold: [BoxPlane; 2],
-    planes: [BoxPlane; BOX_PLANES],
+    planes: [PlaneGroup; PLANE_GROUPS],
     weight: Option<FastWeight>,
     planar: Option<PlanarEdge>,
-    /// The bounding planes four to a vector, for [`ScanWedge::cut_planes`].
-    cut: PlaneGroups,
 }
 
 /// Groups of four planes for [`PLANE_GROUPS`] x 4 plane slots.
@@ -97,24 +107,45 @@ const PLANE_GROUPS: usize = BOX_PLANES.div_ceil(4);
 /// a view sample and of its bound over a tile's box.
 const CUT_PAD: f32 = 1e-5;
 
-/// A wedge's bounding planes in structure-of-arrays form: the normals' components and the
-/// offsets lowered by their margin (`d - CUT_PAD |d|`), four planes to a vector; unused slots
-/// have a zero normal and a positive offset.
+/// Four bounding planes in structure-of-arrays form: the normals' components and the offsets,
+/// one plane per lane; unused slots are open (a zero normal and a positive offset).
 #[derive(Debug, Clone, Copy)]
-struct PlaneGroups {
-    n: [[Vec4; PLANE_GROUPS]; 3],
-    d_low: [Vec4; PLANE_GROUPS],
+#[repr(C)]
+struct PlaneGroup {
+    n: [Vec4; 3],
+    d: Vec4,
 }
 
-impl PlaneGroups {
-    fn new(planes: &[BoxPlane; BOX_PLANES]) -> Self {
-        let slot = |k: usize| planes.get(k).copied().unwrap_or(OPEN);
-        let group = |g: usize, f: &dyn Fn(Vec4) -> f32| {
-            Vec4::from_array(std::array::from_fn(|l| f(slot(4 * g + l))))
-        };
+impl PlaneGroup {
+    /// Slots `4 g` to `4 g + 3` of `planes` (open past its end).
+    fn new(planes: &[BoxPlane], g: usize) -> Self {
+        let slot = |l: usize| planes.get(4 * g + l).copied().unwrap_or(OPEN);
+        let lanes = |k: usize| Vec4::from_array(std::array::from_fn(|l| slot(l)[k]));
         Self {
-            n: std::array::from_fn(|k| std::array::from_fn(|g| group(g, &|p: Vec4| p[k]))),
-            d_low: std::array::from_fn(|g| group(g, &|p: Vec4| p.w - CUT_PAD * p.w.abs())),
+            n: [lanes(0), lanes(1), lanes(2)],
+            d: lanes(3),
+        }
+    }
+}
+
+/// Plane `k` of `groups` as its coefficients `n.x`, `n.y`, `n.z`, `d`, each a scalar.
+#[inline(always)]
+fn plane_of(groups: &[PlaneGroup; PLANE_GROUPS], k: usize) -> [f32; 4] {
+    let (g, l) = (&groups[k / 4], k % 4);
+    [g.n[0], g.n[1], g.n[2], g.d].map(|v| v.as_ref()[l])
+}
+
+/// Calls `f` with each of the first `used` planes of `groups`, in order, as its coefficients.
+#[inline(always)]
+fn each_plane(groups: &[PlaneGroup; PLANE_GROUPS], used: usize, mut f: impl FnMut([f32; 4])) {
+    for (g, p) in groups.iter().enumerate() {
+        let lanes = used.saturating_sub(4 * g).min(4);
+        if lanes == 0 {
+            break;
+        }
+        let [x, y, z, d] = [p.n[0], p.n[1], p.n[2], p.d].map(|v| v.to_array());
+        for l in 0..lanes {
+            f([x[l], y[l], z[l], d[l]]);
         }
     }
 }
@@ -152,15 +183,14 @@ impl ScanWedge {
             Some((a, b)) => [plane(a), plane(b)],
             None => [OPEN, OPEN],
         };
-        let planes = std::array::from_fn(|k| w.planes.get(k).map_or(OPEN, plane));
+        let planes: Vec<BoxPlane> = w.planes.iter().take(BOX_PLANES).map(plane).collect();
         Self {
-            planes,
-            used: w.planes.len().min(BOX_PLANES) as u32,
+            planes: std::array::from_fn(|g| PlaneGroup::new(&planes, g)),
+            used: planes.len() as u32,
             fold,
             weight: w.weight,
             planar,
             edge: w.edge,
-            cut: PlaneGroups::new(&planes),
         }
     }
 
@@ -170,9 +200,11 @@ impl ScanWedge {
     #[inline]
     fn cut_planes(&self, e: &TileExtent) -> u32 {
         let mut m = 0u32;
-        for g in 0..PLANE_GROUPS {
-            let [nx, ny, nz] = [self.cut.n[0][g], self.cut.n[1][g], self.cut.n[2][g]];
-            let centre = nx * e.centre[0] + ny * e.centre[1] + nz * e.centre[2] + self.cut.d_low[g];
+        for (g, p) in self.planes.iter().enumerate() {
+            let [nx, ny, nz] = p.n;
+            // The offsets lowered by the margin.
+            let d_low = p.d - Vec4::splat(CUT_PAD) * p.d.abs();
+            let centre = nx * e.centre[0] + ny * e.centre[1] + nz * e.centre[2] + d_low;
             let reach = nx.abs() * e.half[0] + ny.abs() * e.half[1] + nz.abs() * e.half[2];
             // A NaN is cut: the lanes test it.
             m |= (!(centre - reach).cmpgt(Vec4::ZERO).bitmask() & 0xf) << (4 * g);
@@ -210,8 +242,7 @@ impl ScanWedge {
             if alive == 0 {
                 break;
             }
-            let p = &self.planes[k];
-            let [nx, ny, nz, d] = p.to_array().map(Vec4::splat);
+            let [nx, ny, nz, d] = plane_of(&self.planes, k).map(Vec4::splat);
             for q in 0..QUADS {
                 let v = nx * t.x[q] + ny * t.y[q] + nz * t.z[q] + d;
                 alive &= !((v.cmplt(Vec4::ZERO).bitmask() as LaneMask) << (4 * q));
@@ -275,14 +306,14 @@ impl Boxes {
     /// Per axis, the bounds at the boxes' corners farthest along `n` (the plane's largest
     /// values) and at the nearest ones (its smallest).
     #[inline(always)]
-    fn corners(&self, n: Vec4) -> Corners<'_> {
+    fn corners(&self, [x, y, z, _]: [f32; 4]) -> Corners<'_> {
         // The sign bit picks the bounds without a comparison (a zero or NaN component may
         // take either: its products are zero or NaN at both).
         let pick = |k: usize, c: f32| {
             let neg = (c.to_bits() >> 31) as usize;
             (&self.bounds[k][neg], &self.bounds[k][neg ^ 1])
         };
-        let ((fx, nx), (fy, ny), (fz, nz)) = (pick(0, n.x), pick(1, n.y), pick(2, n.z));
+        let ((fx, nx), (fy, ny), (fz, nz)) = (pick(0, x), pick(1, y), pick(2, z));
         ([fx, fy, fz], [nx, ny, nz])
     }
 
@@ -298,13 +329,13 @@ impl Boxes {
         }
         let live = &live[..count];
         let mut reject = [BVec4A::splat(false); BOXES / 4];
-        for p in &w.planes[..w.used as usize] {
-            let ([x, y, z], _) = self.corners(*p);
-            let s = splat(*p);
+        each_plane(&w.planes, w.used as usize, |p| {
+            let ([x, y, z], _) = self.corners(p);
+            let s = p.map(Vec4::splat);
             for (r, &q) in reject.iter_mut().zip(live) {
                 *r |= eval(s, x[q], y[q], z[q]).cmplt(Vec4::ZERO);
             }
-        }
+        });
         let fold = FoldTest::new(self, w, slack);
         let mut mask = 0u64;
         for (r, &q) in reject.iter().zip(live) {
@@ -332,13 +363,13 @@ impl Boxes {
     fn test_quads_up_to<const Q: usize>(&self, w: &ScanWedge, slack: f32, quads: usize) -> u64 {
         let quads = quads.min(Q);
         let mut reject = [BVec4A::splat(false); Q];
-        for p in &w.planes[..w.used as usize] {
-            let ([x, y, z], _) = self.corners(*p);
-            let n = splat(*p);
+        each_plane(&w.planes, w.used as usize, |p| {
+            let ([x, y, z], _) = self.corners(p);
+            let n = p.map(Vec4::splat);
             for q in 0..quads {
                 reject[q] |= eval(n, x[q], y[q], z[q]).cmplt(Vec4::ZERO);
             }
-        }
+        });
         let fold = FoldTest::new(self, w, slack);
         let mut mask = 0u64;
         for (q, r) in reject[..quads].iter().enumerate() {
@@ -379,7 +410,8 @@ impl<'a> FoldTest<'a> {
     #[inline(always)]
     fn new(boxes: &'a Boxes, w: &ScanWedge, slack: f32) -> Self {
         let [f1, f2] = w.fold;
-        let ((far1, near1), (far2, near2)) = (boxes.corners(f1), boxes.corners(f2));
+        let ((far1, near1), (far2, near2)) =
+            (boxes.corners(f1.to_array()), boxes.corners(f2.to_array()));
         Self {
             planes: [splat(f1), splat(f2)],
             far: [far1, far2],
@@ -1077,13 +1109,12 @@ mod tests {
                 *plane = n.extend(-at + shift);
             }
             let w = ScanWedge {
-                planes,
+                planes: std::array::from_fn(|g| PlaneGroup::new(&planes, g)),
                 fold: [OPEN, OPEN],
                 used: BOX_PLANES as u32,
                 edge: 0,
                 weight: None,
                 planar: None,
-                cut: PlaneGroups::new(&planes),
             };
             let bounds = tile.bounds();
             let cut = w.cut_planes(&TileExtent::new(bounds));
@@ -1140,13 +1171,12 @@ mod tests {
             let mut planes = [OPEN; BOX_PLANES];
             planes[0] = plane;
             let w = ScanWedge {
-                planes,
+                planes: std::array::from_fn(|g| PlaneGroup::new(&planes, g)),
                 fold: [OPEN, OPEN],
                 used: 1,
                 edge: 0,
                 weight: None,
                 planar: None,
-                cut: PlaneGroups::new(&planes),
             };
             let mask = b.test(&w, 0.0);
             for (i, bx) in boxes.iter().enumerate() {
