@@ -93,8 +93,8 @@ impl PlanarEdge {
         let cx = (px * r(0) + py * r(1) + pz * r(2) + Vec4::from(self.kx)) * s;
         let cy = (px * r(3) + py * r(4) + pz * r(5) + Vec4::from(self.ky)) * s;
         Some(PlanarTest {
-            cx,
-            cy,
+            cx: cx.to_array(),
+            cy: cy.to_array(),
             k2: if positive { mp } else { -mp },
             k: 0,
         })
@@ -107,10 +107,12 @@ impl PlanarEdge {
 /// covered.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct PlanarTest {
-    /// `(a.x, -b.x, w1.x, h2.x)`.
-    cx: Vec4,
+    /// `(a.x, -b.x, w1.x, h2.x)` (arrays rather than vectors: without their 16-byte alignment a
+    /// test takes 40 bytes, not 48, and a pixel's list of them is read once after being written
+    /// once).
+    cx: [f32; 4],
     /// `(a.y, -b.y, w1.y, h2.y)`.
-    cy: Vec4,
+    cy: [f32; 4],
     /// The constant of the last form.
     k2: f32,
     /// The pair's weight `k_e(p)` (it fills the padding after `k2`, so a pixel's pairs need no
@@ -121,8 +123,8 @@ pub(crate) struct PlanarTest {
 impl PlanarTest {
     /// A placeholder that covers nothing.
     pub const NONE: Self = Self {
-        cx: Vec4::ZERO,
-        cy: Vec4::ZERO,
+        cx: [0.0; 4],
+        cy: [0.0; 4],
         k2: 0.0,
         k: 0,
     };
@@ -131,8 +133,8 @@ impl PlanarTest {
     #[cfg(test)]
     pub fn sector(&self) -> (glam::Vec2, glam::Vec2) {
         (
-            glam::Vec2::new(self.cx.x, self.cy.x),
-            glam::Vec2::new(-self.cx.y, -self.cy.y),
+            glam::Vec2::new(self.cx[0], self.cy[0]),
+            glam::Vec2::new(-self.cx[1], -self.cy[1]),
         )
     }
 
@@ -140,18 +142,19 @@ impl PlanarTest {
     /// component.
     #[inline]
     pub fn coefficients(&self) -> (Vec4, Vec4) {
-        (self.cx, self.cy)
+        (Vec4::from_array(self.cx), Vec4::from_array(self.cy))
     }
 
     /// The samples of `subset` (one word: `xs`, `ys` hold its 64 samples) the edge covers.
     #[inline(always)]
     pub fn covered_of(&self, xs: &[f32; 64], ys: &[f32; 64], subset: u64) -> u64 {
         let c0 = Vec4::new(0.0, 0.0, 0.0, self.k2);
+        let (cx, cy) = self.coefficients();
         let (mut todo, mut out) = (subset, 0u64);
         while todo != 0 {
             let k = todo.trailing_zeros() as usize & 63;
             todo &= todo - 1;
-            let v = self.cx * xs[k] + self.cy * ys[k] + c0;
+            let v = cx * xs[k] + cy * ys[k] + c0;
             if v.cmpgt(Vec4::ZERO).all() {
                 out |= 1 << k;
             }
@@ -162,7 +165,8 @@ impl PlanarTest {
     /// Whether the sample at in-plane coordinates `(x, y)` is covered.
     #[inline(always)]
     pub fn covers(&self, x: f32, y: f32) -> bool {
-        (self.cx * x + self.cy * y + Vec4::new(0.0, 0.0, 0.0, self.k2))
+        let (cx, cy) = self.coefficients();
+        (cx * x + cy * y + Vec4::new(0.0, 0.0, 0.0, self.k2))
             .cmpgt(Vec4::ZERO)
             .all()
     }
@@ -188,7 +192,7 @@ impl PlanarTest {
         let base = w * 64;
         let (xs, _) = samples.x[base..base + 64].as_chunks::<4>();
         let (ys, _) = samples.y[base..base + 64].as_chunks::<4>();
-        let f = |c: Vec4| -> [Vec4; 4] { [c.x, c.y, c.z, c.w].map(Vec4::splat) };
+        let f = |c: [f32; 4]| -> [Vec4; 4] { c.map(Vec4::splat) };
         let (cx, cy, c0) = (f(self.cx), f(self.cy), self.k2);
         let mut bits = 0u64;
         for (q, (x, y)) in xs.iter().zip(ys).enumerate() {
