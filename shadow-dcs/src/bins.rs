@@ -889,7 +889,8 @@ pub(crate) fn tile_pairs(
 }
 
 /// The light-plane test of wedge `wi` (`pe`, its edge in light-plane form) from view sample
-/// `i` (`l1` at least the length of its light-centred position): `None` on the tie of the
+/// `i` (`pc`, its light-centred position, taken from the tile's lanes rather than the image so
+/// that a pair reads no more of the frame; `l1` at least `|pc|_1`): `None` on the tie of the
 /// orientation.
 #[inline]
 pub(crate) fn planar_test(
@@ -897,6 +898,7 @@ pub(crate) fn planar_test(
     pe: &PlanarEdge,
     wi: u32,
     i: usize,
+    pc: Vec3,
     l1: f32,
 ) -> Option<PlanarTest> {
     let exact = || {
@@ -904,7 +906,7 @@ pub(crate) fn planar_test(
         let pc = input.origins[i].as_dvec3() - input.c;
         centred_edges[wi as usize].orientation(pc)
     };
-    pe.test(input.centred[i], l1, exact)
+    pe.test(pc, l1, exact)
 }
 
 /// Per-thread buffers of the square scan.
@@ -978,7 +980,14 @@ pub(crate) fn square_pairs(
                 counts,
                 |j, i, k| {
                     match pe.filter(|_| planar_lanes >> j & 1 == 1) {
-                        Some(pe) => match planar_test(input, pe, wi, i, tile.l1[j]) {
+                        Some(pe) => match planar_test(
+                            input,
+                            pe,
+                            wi,
+                            i,
+                            Vec3::new(tile.x[j], tile.y[j], tile.z[j]),
+                            tile.l1[j],
+                        ) {
                             Some(mut t) => {
                                 t.k = k;
                                 tests[j].push(t);
