@@ -70,23 +70,22 @@ type BoxPlane = Vec4;
 /// The plane every box passes (`0 . x + 1 >= 0`): unused plane slots.
 const OPEN: BoxPlane = Vec4::new(0.0, 0.0, 0.0, 1.0);
 
-/// Everything the wedge scan reads of one wedge, in one place (the scan visits wedges in
-/// silhouette order, square by square): its bounding planes and the planes of its edge's two
-/// faces for box tests (the bounding planes also test view samples), its weight from plane
-/// signs, and its edge prepared for the light-plane test.
+/// What the box tests read of one wedge (the scan visits wedges in silhouette order, square by
+/// square): its bounding planes and the planes of its edge's two faces (the bounding planes
+/// also test view samples). The rest of what the view samples' pass reads is in
+/// [`WedgeLanes`].
 ///
-/// Laid out in declaration order (`repr(C)`) on cache-line boundaries, so that a box test's
-/// data (the count, the fold planes, then the groups of bounding planes in use) fills the
-/// wedge's first lines: up to eight planes in three lines. Left to the compiler, the fields
-/// were reordered (the tile data first, the count after the weight), and a box test touched
-/// five lines of 656 bytes; in declaration order `bunny`'s simulated last-level misses fell by
-/// 10% (3,029 k to 2,729 k), with no change in wall time measured. The bounding planes are
-/// kept once, four to a group in structure-of-arrays form, which both the box tests (one plane
-/// at a time) and [`ScanWedge::cut_planes`] (a group at a time) read. With a second copy in
-/// plane-by-plane form a wedge took 704 bytes; one copy took it to 512 and `bunny` `dcs-64`
-/// from 0.138 s to 0.118 s on two threads (`scripts/dcs_ab.sh`, 8 rounds; 0.262 s to 0.219 s
-/// on one), for the same instructions (1786 M -> 1784 M) and 4% fewer simulated L1 misses:
-/// the smaller records are what a square's wedges keep in the caches.
+/// Laid out in declaration order (`repr(C)`) on cache-line boundaries: the count, the fold
+/// planes, then the groups of bounding planes, up to eight planes in three lines (192 bytes).
+/// Left to the compiler, the fields were reordered (the tile data first, the count after the
+/// weight), and a box test touched five lines of 656 bytes; in declaration order `bunny`'s
+/// simulated last-level misses fell by 10% (3,029 k to 2,729 k), with no change in wall time
+/// measured. The bounding planes are kept once, four to a group in structure-of-arrays form,
+/// which both the box tests (one plane at a time) and [`ScanWedge::cut_planes`] (a group at a
+/// time) read. With a second copy in plane-by-plane form a wedge took 704 bytes; one copy took
+/// it to 512 and `bunny` `dcs-64` from 0.138 s to 0.118 s on two threads (`scripts/dcs_ab.sh`,
+/// 8 rounds; 0.262 s to 0.219 s on one), for the same instructions (1786 M -> 1784 M) and 4%
+/// fewer simulated L1 misses: smaller records are what a square's wedges keep in the caches.
 #[derive(Debug, Clone, Copy)]
 #[repr(C, align(64))]
 pub(crate) struct ScanWedge {
@@ -96,6 +95,17 @@ pub(crate) struct ScanWedge {
     edge: u32,
     fold: [BoxPlane; 2],
     planes: [PlaneGroup; PLANE_GROUPS],
+}
+
+/// What the view samples' pass reads of a wedge besides its [`ScanWedge`]: its weight from
+/// plane signs and its edge prepared for the light-plane test (256 bytes). Kept apart from the
+/// box-test data, so that the box tests of every level, which most wedges do not pass, read
+/// densely packed 192-byte records rather than 448-byte ones: `bunny` `dcs-64` 1758 M -> 1763 M
+/// instructions, and in wall time 0.1237 s -> 0.1208 s on two threads (8 A/B rounds), 0.236 s
+/// -> 0.225 s on one (mean of 8 alternating runs).
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
+pub(crate) struct WedgeLanes {
     weight: Option<FastWeight>,
     planar: Option<PlanarEdge>,
 }
@@ -173,7 +183,7 @@ impl TileExtent {
 
 impl ScanWedge {
     /// The scan data of wedge `w`, with its edge in light-plane form for planar lights.
-    pub fn new(w: &Wedge, planar: Option<PlanarEdge>) -> Self {
+    pub fn new(w: &Wedge, planar: Option<PlanarEdge>) -> (Self, WedgeLanes) {
         let plane = |p: &CentredPlane| -> BoxPlane {
             let (n, d) = p.coefficients();
             n.extend(d)
@@ -184,14 +194,17 @@ impl ScanWedge {
             None => [OPEN, OPEN],
         };
         let planes: Vec<BoxPlane> = w.planes.iter().take(BOX_PLANES).map(plane).collect();
-        Self {
+        let scan = Self {
             planes: std::array::from_fn(|g| PlaneGroup::new(&planes, g)),
             used: planes.len() as u32,
             fold,
+            edge: w.edge,
+        };
+        let lanes = WedgeLanes {
             weight: w.weight,
             planar,
-            edge: w.edge,
-        }
+        };
+        (scan, lanes)
     }
 
     /// The bounding planes (one bit each) that may put a view sample of a tile with extent
@@ -868,7 +881,8 @@ pub(crate) fn tile_pairs(
     if inside == 0 {
         return;
     }
-    let fast = wedge.weight.as_ref().and_then(|f| f.weight_lanes(quads));
+    let weight = &input.lanes[wi as usize].weight;
+    let fast = weight.as_ref().and_then(|f| f.weight_lanes(quads));
     for j in lanes_of(inside) {
         let i = pixels[j];
         let k = match &fast {
@@ -919,6 +933,8 @@ pub(crate) struct SquareScratch {
 pub(crate) struct ScanInput<'a> {
     pub edges: &'a [SceneEdge],
     pub wedges: &'a [ScanWedge],
+    /// The same wedges' data for the view samples' pass.
+    pub lanes: &'a [WedgeLanes],
     /// The light centre.
     pub c: DVec3,
     pub width: u32,
@@ -963,7 +979,7 @@ pub(crate) fn square_pairs(
         let wedge = &input.wedges[wi as usize];
         let mask = tiles.boxes.test(wedge, input.slack);
         counts.tile_wedges += u64::from(mask.count_ones());
-        let pe = wedge.planar.as_ref();
+        let pe = input.lanes[wi as usize].planar.as_ref();
         for t in bits_of(mask) {
             let (tile, scan) = (&tiles.lanes[t], &tiles.tiles[t]);
             counts.scanned += u64::from(tile.active.count_ones());
@@ -1032,7 +1048,7 @@ mod tests {
         let sil = silhouettes(&edges, &shape, Silhouettes::Accurate);
         let scan: Vec<ScanWedge> = wedges(&edges, &sil, &shape)
             .iter()
-            .map(|w| ScanWedge::new(w, None))
+            .map(|w| ScanWedge::new(w, None).0)
             .collect();
         let c = shape.center.as_dvec3();
         let n = view.len();
@@ -1122,8 +1138,6 @@ mod tests {
                 fold: [OPEN, OPEN],
                 used: BOX_PLANES as u32,
                 edge: 0,
-                weight: None,
-                planar: None,
             };
             let bounds = tile.bounds();
             let cut = w.cut_planes(&TileExtent::new(bounds));
@@ -1184,8 +1198,6 @@ mod tests {
                 fold: [OPEN, OPEN],
                 used: 1,
                 edge: 0,
-                weight: None,
-                planar: None,
             };
             let mask = b.test(&w, 0.0);
             for (i, bx) in boxes.iter().enumerate() {
@@ -1227,7 +1239,8 @@ mod tests {
             let (edges, _) = scene_edges(scene, shape.center);
             let sil = silhouettes(&edges, &shape, Silhouettes::Accurate);
             let ws = wedges(&edges, &sil, &shape);
-            let scan: Vec<ScanWedge> = ws.iter().map(|w| ScanWedge::new(w, None)).collect();
+            let (scan, lanes): (Vec<ScanWedge>, Vec<WedgeLanes>) =
+                ws.iter().map(|w| ScanWedge::new(w, None)).unzip();
             let extent = scene.bounds().union(light.bounds()).diagonal();
             let offset = RayOffset::for_extent(extent);
             let c = shape.center.as_dvec3();
@@ -1244,6 +1257,7 @@ mod tests {
             let input = ScanInput {
                 edges: &edges,
                 wedges: &scan,
+                lanes: &lanes,
                 c,
                 width: w,
                 origins: &origins,

@@ -46,7 +46,7 @@ use shadow_core::visibility::{PerSampleVisibility, PixelClass};
 use crate::angular::{AngularIndex, BATCH, QuadRanges};
 use crate::bins::{
     BlockWedges, Rect, SQUARE, ScanCounts, ScanInput, ScanWedge, SquarePairs, SquareScratch,
-    square_pairs,
+    WedgeLanes, square_pairs,
 };
 use crate::centred::CentredEdge;
 use crate::constant::{eye_constant, integration_constants};
@@ -85,8 +85,10 @@ struct Prepared {
     polygon: Option<Vec<Vec3>>,
     /// The silhouette edges around the light centre (same indices as `silhouettes`).
     centred_edges: Vec<CentredEdge>,
-    /// What the wedge scan reads of every silhouette edge's wedge (same indices).
+    /// What the wedge scan's box tests read of every silhouette edge's wedge (same indices).
     scan: Vec<ScanWedge>,
+    /// What the view samples' pass reads of the same wedges.
+    scan_lanes: Vec<WedgeLanes>,
     /// The light-plane form of the silhouette edges, for planar lights.
     planar: Option<PlanarLight>,
     /// A constant rectangle light's half sides on the light plane's axes: its samples' plane
@@ -452,6 +454,7 @@ impl Dcs {
         ScanInput {
             edges: &p.edges,
             wedges: &p.scan,
+            lanes: &p.scan_lanes,
             c: p.shape.center.as_dvec3(),
             width: f.view.width(),
             origins: &f.origins,
@@ -1354,7 +1357,7 @@ impl ShadowTechnique for Dcs {
             }
             _ => None,
         };
-        let scan = wedges
+        let (scan, scan_lanes) = wedges
             .par_iter()
             .map(|w| {
                 let pe = shape.plane.as_ref().map(|pl| {
@@ -1363,11 +1366,12 @@ impl ShadowTechnique for Dcs {
                 });
                 ScanWedge::new(w, pe)
             })
-            .collect();
+            .unzip();
         self.prepared = Some(Prepared {
             planar,
             rect,
             scan,
+            scan_lanes,
             polygon,
             centred_edges,
             scene,
