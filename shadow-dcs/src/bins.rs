@@ -792,13 +792,17 @@ pub(crate) struct SquareTiles {
 }
 
 /// What a wedge's test on a tile's view samples reads: the view samples as packed quads, the
-/// tile's box, each lane's image index, and the lanes that take the light-plane test.
+/// tile's box, each lane's image index, the lanes that take the light-plane test, and the
+/// number of active lanes.
 #[derive(Clone, Copy)]
 struct ScanTile {
     quads: TileQuads,
     extent: TileExtent,
     pixels: [usize; LANES],
     planar_lanes: LaneMask,
+    /// Active view samples (this target has no population count instruction: counted once
+    /// per tile, not once per wedge).
+    active: u32,
 }
 
 impl SquareTiles {
@@ -835,6 +839,7 @@ impl SquareTiles {
                 extent: TileExtent::new(*bounds),
                 pixels,
                 planar_lanes,
+                active: tile.active.count_ones(),
             });
         }
     }
@@ -979,10 +984,9 @@ pub(crate) fn square_pairs(
         let wedge = &input.wedges[wi as usize];
         let mask = tiles.boxes.test(wedge, input.slack);
         counts.tile_wedges += u64::from(mask.count_ones());
-        let pe = input.lanes[wi as usize].planar.as_ref();
         for t in bits_of(mask) {
             let (tile, scan) = (&tiles.lanes[t], &tiles.tiles[t]);
-            counts.scanned += u64::from(tile.active.count_ones());
+            counts.scanned += u64::from(scan.active);
             let planar_lanes = scan.planar_lanes;
             let entries = &mut out.entries[t * LANES..(t + 1) * LANES];
             let tests = &mut out.tests[t * LANES..(t + 1) * LANES];
@@ -995,6 +999,9 @@ pub(crate) fn square_pairs(
                 &scan.pixels,
                 counts,
                 |j, i, k| {
+                    // Read here, not per wedge: a wedge whose tiles give no pair leaves its
+                    // lanes' record untouched.
+                    let pe = input.lanes[wi as usize].planar.as_ref();
                     match pe.filter(|_| planar_lanes >> j & 1 == 1) {
                         Some(pe) => match planar_test(
                             input,
