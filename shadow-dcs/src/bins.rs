@@ -50,8 +50,9 @@ pub(crate) const SQUARE: u32 = 16;
 /// scenes' wedges have 4 to 9 planes (`bunny`: 2,410 with 4, 25,620 with 6, 3 with 8, 2 with
 /// 9; `quad-over-plane` and `overlapping-occluders` 8 or 9); with 8 rather than 10 the tile
 /// candidates, pairs and covered updates are the same on every built-in scene, and a wedge
-/// takes 448 bytes instead of 512 (`bunny` `dcs-64`: 1784 M -> 1770 M instructions, simulated
-/// last-level misses 2,516 k -> 2,207 k, wall time 5% lower).
+/// took 448 bytes instead of 512 while it was one record (`bunny` `dcs-64`: 1784 M -> 1770 M
+/// instructions, simulated last-level misses 2,516 k -> 2,207 k, wall time 5% lower); its
+/// box-test record ([`ScanWedge`]) now takes 192.
 const BOX_PLANES: usize = 8;
 
 /// Relative padding of a box, far above the rounding of its centre and of a plane evaluated there.
