@@ -183,7 +183,8 @@ impl TileExtent {
 }
 
 impl ScanWedge {
-    /// The scan data of wedge `w`, with its edge in light-plane form for planar lights.
+    /// The scan data of wedge `w`: its box-test record and its record for the view samples'
+    /// pass, with its edge in light-plane form (`planar`) for planar lights.
     pub fn new(w: &Wedge, planar: Option<PlanarEdge>) -> (Self, WedgeLanes) {
         let plane = |p: &CentredPlane| -> BoxPlane {
             let (n, d) = p.coefficients();
