@@ -227,23 +227,19 @@ impl AngularIndex {
         }
     }
 
+    /// The prefix table as `W`-word rows, when the index holds `W` words per row (a fixed
+    /// array: [`QuadRanges::words`] then indexes it without a check).
+    #[inline]
+    pub fn rows<const W: usize>(&self) -> Option<&PrefixRows<W>> {
+        let (rows, _) = self.prefix.as_chunks::<W>();
+        rows.try_into().ok().filter(|_| self.words == W)
+    }
+
     /// The samples that may lie in sector `j` of `r`, for a pixel with `W` words of samples
     /// (the index's rows taken as fixed arrays: no index arithmetic or checks per word).
-    #[inline(always)]
+    #[cfg(test)]
     pub fn quad_words<const W: usize>(&self, r: &QuadRanges, j: usize) -> [u64; W] {
-        if r.narrow >> j & 1 == 0 {
-            return [u64::MAX; W];
-        }
-        let (rows, _) = self.prefix.as_chunks::<W>();
-        let (below_lo, upto_hi) = (rows[r.lo[j]], rows[r.hi[j] + 1]);
-        let wraps = r.wraps >> j & 1 == 1;
-        std::array::from_fn(|w| {
-            if wraps {
-                upto_hi[w] | !below_lo[w]
-            } else {
-                upto_hi[w] & !below_lo[w]
-            }
-        })
+        r.words(self.rows::<W>().expect("an index of W words"), j)
     }
 
     /// The samples of `allowed` that may lie in sector `j` of `r` (every sample the exact
@@ -366,6 +362,9 @@ impl AngularIndex {
     }
 }
 
+/// An index's prefix table with `W` words per row ([`AngularIndex::rows`]).
+pub(crate) type PrefixRows<const W: usize> = [[u64; W]; BUCKETS + 1];
+
 /// The bucket ranges of four light-plane sectors (the cone `a . d > 0`, `b . d < 0`), computed
 /// as in `Normals::sectors`, four lanes at a time.
 pub(crate) struct QuadRanges {
@@ -387,6 +386,27 @@ impl QuadRanges {
         let xs = Mat4::from_cols(c[0].0, c[1].0, c[2].0, c[3].0).transpose();
         let ys = Mat4::from_cols(c[0].1, c[1].1, c[2].1, c[3].1).transpose();
         Self::of(xs.x_axis, ys.x_axis, -xs.y_axis, -ys.y_axis)
+    }
+
+    /// The samples of a pixel's index `rows` that may lie in sector `j`. The bucket numbers
+    /// are below [`BUCKETS`] by construction ([`buckets`] clamps them); the masks only let the
+    /// compiler drop the index checks (two per pair, on the hottest path of `dcs-64`).
+    #[inline(always)]
+    pub fn words<const W: usize>(&self, rows: &PrefixRows<W>, j: usize) -> [u64; W] {
+        if self.narrow >> j & 1 == 0 {
+            return [u64::MAX; W];
+        }
+        const MASK: usize = BUCKETS - 1;
+        const _: () = assert!(BUCKETS.is_power_of_two());
+        let (below_lo, upto_hi) = (rows[self.lo[j] & MASK], rows[(self.hi[j] & MASK) + 1]);
+        let wraps = self.wraps >> j & 1 == 1;
+        std::array::from_fn(|w| {
+            if wraps {
+                upto_hi[w] | !below_lo[w]
+            } else {
+                upto_hi[w] & !below_lo[w]
+            }
+        })
     }
 
     /// The ranges of the cones `a . d > 0`, `b . d < 0` given lane by lane.

@@ -63,7 +63,7 @@ impl CentredPlane {
 
     /// The values at the four lane quads of a tile.
     #[inline(always)]
-    fn eval_quads(&self, t: &TileQuads) -> [Vec4; QUADS] {
+    pub fn eval_quads(&self, t: &TileQuads) -> [Vec4; QUADS] {
         let (nx, ny, nz, d) = (
             Vec4::splat(self.n.x),
             Vec4::splat(self.n.y),
@@ -131,6 +131,16 @@ impl FastWeight {
             faces,
         })
     }
+
+    /// The planes of the edge's two faces, as the weight evaluates them (`N_f . (x - a)`,
+    /// `N_f = (b - a) x (third - a)`), for an edge with two faces. The wedge scan's fold test
+    /// evaluates these same planes, so that [`FastWeight::weight_lanes`] can take its values.
+    pub fn face_planes(&self) -> Option<(CentredPlane, CentredPlane)> {
+        match self.faces {
+            [Some(f1), Some(f2)] => Some((f1.plane, f2.plane)),
+            _ => None,
+        }
+    }
 }
 
 /// `k_e` at every lane of a tile, with the mask of lanes whose signs are all certain (lanes
@@ -162,20 +172,30 @@ impl FastWeight {
     /// sample toward `c`: that rule's side of `c` is the sign of `-N_c . (x - a)` and a face's
     /// side that of `-N_f . (x - a)`; a one-sided face counts only from behind. Four lanes at a
     /// time in packed single precision (the weights are whole numbers well inside its range).
-    /// `None` when a face weight exceeds [`LANE_WEIGHT_MAX`].
+    /// `None` when a face weight exceeds [`LANE_WEIGHT_MAX`]. `faces`, when given, holds the
+    /// two face planes' values at the lanes, as [`CentredPlane::eval_quads`] computes them
+    /// (the wedge scan's fold test has them at hand: [`FastWeight::face_planes`]).
     #[inline]
-    pub fn weight_lanes(&self, t: &TileQuads) -> Option<LaneWeights> {
+    pub fn weight_lanes(
+        &self,
+        t: &TileQuads,
+        faces: Option<&[[Vec4; QUADS]; 2]>,
+    ) -> Option<LaneWeights> {
         let zero = Vec4::ZERO;
         let v = self.through_center.eval_quads(t);
         let mut certain = self.through_center.certain_quads(t, &v);
         let from_negative = v.map(|x| x.cmplt(zero));
         let mut k = [zero; QUADS];
-        for f in self.faces.iter().flatten() {
+        for (i, f) in self.faces.iter().enumerate() {
+            let Some(f) = f else { continue };
             if f.weight > LANE_WEIGHT_MAX {
                 return None;
             }
             let w = Vec4::splat(f.weight as f32);
-            let v = f.plane.eval_quads(t);
+            let v = match faces {
+                Some(values) => values[i],
+                None => f.plane.eval_quads(t),
+            };
             certain &= f.plane.certain_quads(t, &v);
             for q in 0..QUADS {
                 let positive = v[q].cmpgt(zero);
@@ -350,7 +370,7 @@ mod tests {
             let tile = tiles[0];
             let lanes = FastWeight::new(&edge, c)
                 .unwrap()
-                .weight_lanes(&tile.quads())
+                .weight_lanes(&tile.quads(), None)
                 .unwrap();
             for (j, p) in points.iter().enumerate() {
                 total += 1;
@@ -372,9 +392,61 @@ mod tests {
         assert!(
             FastWeight::new(&edge, c)
                 .unwrap()
-                .weight_lanes(&tile.quads())
+                .weight_lanes(&tile.quads(), None)
                 .is_none()
         );
+    }
+
+    /// Given its face planes' values (as the wedge scan's fold test computes them), the lane
+    /// weight is the one it computes itself: the same weights and the same certain lanes.
+    #[test]
+    fn lane_weights_from_the_fold_values_are_the_same() {
+        let mut compared = 0;
+        for k in 0..300u64 {
+            let r = |i: u64| unit_float(hash_words(&[k, i])) as f64 * 2.0 - 1.0;
+            let (c, mut edge) = random_edge(k, 0.0, (k % 2 == 0, k % 4 < 2), k % 3 == 0);
+            for (f, w) in edge.faces.iter_mut().zip(weights(k / 3)) {
+                f.weight = w;
+            }
+            let fast = FastWeight::new(&edge, c).unwrap();
+            let (f1, f2) = fast.face_planes().expect("two faces");
+            let lanes: Vec<Vec3> = (0..LANES as u64)
+                .map(|j| {
+                    let p = DVec3::new(
+                        r(20 + 3 * j) * 2.0,
+                        r(21 + 3 * j) * 0.2,
+                        r(22 + 3 * j) * 2.0,
+                    );
+                    (p - c).as_vec3()
+                })
+                .collect();
+            let mut tiles = Vec::new();
+            rect_lanes(
+                TILE_W,
+                (0, TILE_W - 1),
+                (0, TILE_H - 1),
+                &lanes,
+                &[true; LANES],
+                &mut tiles,
+            );
+            let t = tiles[0].quads();
+            let values = [f1.eval_quads(&t), f2.eval_quads(&t)];
+            match (
+                fast.weight_lanes(&t, None),
+                fast.weight_lanes(&t, Some(&values)),
+            ) {
+                (Some(a), Some(b)) => {
+                    assert_eq!(a.certain, b.certain, "case {k}");
+                    for j in 0..LANES {
+                        assert_eq!(a.k(j), b.k(j), "case {k} lane {j}");
+                    }
+                    compared += 1;
+                }
+                (None, None) => {}
+                _ => panic!("case {k}: one form answers, the other not"),
+            }
+        }
+        assert!(compared > 200, "{compared}");
     }
 
     /// The single-precision weight and test agree with the double-precision ones wherever
@@ -391,7 +463,7 @@ mod tests {
             let pc = (p - c).as_vec3();
             let fast = FastWeight::new(&edge, c).unwrap();
             total += 1;
-            let lanes = fast.weight_lanes(&TileLanes::at(pc).quads()).unwrap();
+            let lanes = fast.weight_lanes(&TileLanes::at(pc).quads(), None).unwrap();
             if lanes.certain & 1 == 1 {
                 answered += 1;
                 let k = lanes.k(0);

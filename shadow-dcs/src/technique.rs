@@ -1120,13 +1120,15 @@ impl Dcs {
         };
         let samples = &scratch.planar_samples;
         let (xs, ys) = (samples.words_x::<W>(), samples.words_y::<W>());
-        let index = &scratch.angular;
+        let Some(rows) = scratch.angular.rows::<W>() else {
+            return false;
+        };
         let (masks, weights) = (&mut scratch.masks, &mut scratch.weights);
         let (mut empty, mut covered) = (0, 0);
         let mut quad_of = |four: &[PlanarTest; 4], n: usize| {
             let r = QuadRanges::of_tests(four);
             for (j, test) in four[..n].iter().enumerate() {
-                let mut cand = index.quad_words::<W>(&r, j);
+                let mut cand = r.words(rows, j);
                 let mut any = 0;
                 for (c, a) in cand.iter_mut().zip(&above) {
                     *c &= a;

@@ -217,14 +217,24 @@ pub(crate) fn wedges(edges: &[SceneEdge], silhouettes: &[u32], light: &LightShap
         .par_iter()
         .map(|&ei| {
             let e = &edges[ei as usize];
+            let weight = FastWeight::new(e, c);
+            // The fold planes are the weight's own face planes where it has them (the same
+            // planes up to scale and rounding), so that the scan hands the fold test's values
+            // to the weight.
+            let fold = fold_planes(e).map(|(a, b)| {
+                weight
+                    .as_ref()
+                    .and_then(FastWeight::face_planes)
+                    .unwrap_or((a.centred(c), b.centred(c)))
+            });
             Wedge {
                 edge: ei,
                 planes: wedge_planes(e, light)
                     .iter()
                     .map(|p| p.centred(c))
                     .collect(),
-                fold: fold_planes(e).map(|(a, b)| (a.centred(c), b.centred(c))),
-                weight: FastWeight::new(e, c),
+                fold,
+                weight,
             }
         })
         .collect()
