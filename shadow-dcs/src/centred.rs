@@ -305,6 +305,20 @@ mod tests {
     }
 
     /// Face weights for case `k`: one, a semi-opaque occluder's units, the lane form's largest.
+    /// A tile whose every lane holds one of `centred` (one per lane, in lane order).
+    fn full_tile(centred: &[Vec3]) -> TileLanes {
+        let mut tiles = Vec::new();
+        rect_lanes(
+            TILE_W,
+            (0, TILE_W - 1),
+            (0, TILE_H - 1),
+            centred,
+            &[true; LANES],
+            &mut tiles,
+        );
+        tiles[0]
+    }
+
     fn weights(k: u64) -> [u32; 2] {
         let w = [1, 1, 255, LANE_WEIGHT_MAX as u32];
         [w[(k % 4) as usize], w[(k / 4 % 4) as usize]]
@@ -358,16 +372,7 @@ mod tests {
                 })
                 .collect();
             let centred: Vec<Vec3> = points.iter().map(|p| (*p - c).as_vec3()).collect();
-            let mut tiles = Vec::new();
-            rect_lanes(
-                TILE_W,
-                (0, TILE_W - 1),
-                (0, TILE_H - 1),
-                &centred,
-                &[true; LANES],
-                &mut tiles,
-            );
-            let tile = tiles[0];
+            let tile = full_tile(&centred);
             let lanes = FastWeight::new(&edge, c)
                 .unwrap()
                 .weight_lanes(&tile.quads(), None)
@@ -420,16 +425,7 @@ mod tests {
                     (p - c).as_vec3()
                 })
                 .collect();
-            let mut tiles = Vec::new();
-            rect_lanes(
-                TILE_W,
-                (0, TILE_W - 1),
-                (0, TILE_H - 1),
-                &lanes,
-                &[true; LANES],
-                &mut tiles,
-            );
-            let t = tiles[0].quads();
+            let t = full_tile(&lanes).quads();
             let values = [f1.eval_quads(&t), f2.eval_quads(&t)];
             match (
                 fast.weight_lanes(&t, None),
