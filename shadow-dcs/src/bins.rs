@@ -868,14 +868,13 @@ impl SquareTiles {
     }
 }
 
-/// The pairs of wedge `wi` with the view samples of a tile (`tile`, `quads`, its box `extent`,
-/// the image index of each lane in `pixels`): the fold planes (where the edge may be a
-/// silhouette), then the bounding planes that may cut the tile's box on the view samples left,
-/// then the weights where any is inside, exact where the single-precision signs are uncertain.
-/// Calls `pair(lane, image index, k)` for each view sample with a non-zero weight, in lane
-/// order.
+/// The weights of wedge `wi` at the view samples of a tile (`tile`, `quads`, its box
+/// `extent`, the image index of each lane in `pixels`): the fold planes (where the edge may be
+/// a silhouette), then the bounding planes that may cut the tile's box on the view samples
+/// left, then the weights where any is inside, exact where the single-precision signs are
+/// uncertain. Returns the lanes with a non-zero weight (one bit each) and every lane's weight.
 #[inline]
-pub(crate) fn tile_pairs(
+pub(crate) fn tile_weights(
     input: &ScanInput,
     wi: u32,
     tile: &TileLanes,
@@ -883,8 +882,8 @@ pub(crate) fn tile_pairs(
     extent: &TileExtent,
     pixels: &[usize; LANES],
     counts: &mut ScanCounts,
-    mut pair: impl FnMut(usize, usize, i32),
-) {
+) -> (LaneMask, [i32; LANES]) {
+    let mut ks = [0i32; LANES];
     let wedge = &input.wedges[wi as usize];
     // Where the edge cannot be a silhouette of the view sample (its face planes surely differ
     // in sign there), the weight is zero: those view samples take neither the weight nor the
@@ -892,35 +891,37 @@ pub(crate) fn tile_pairs(
     let (fold, values) = wedge.fold_lanes(quads, input.slack);
     let fold = fold & tile.active;
     if fold == 0 {
-        return;
+        return (0, ks);
     }
     // Where the edge may be a silhouette its weight is rarely zero (on `bunny`, at no view
     // sample the fold test keeps), so the planes come first and the weights are taken only
     // for tiles with a view sample inside.
     let inside = wedge.inside(quads, fold, wedge.cut_planes(extent));
     if inside == 0 {
-        return;
+        return (0, ks);
     }
     let weight = &input.lanes[wi as usize].weight;
     let faces = wedge.folded.then_some(&values);
     let fast = weight.as_ref().and_then(|f| f.weight_lanes(quads, faces));
+    let mut nonzero: LaneMask = 0;
     for j in lanes_of(inside) {
-        let i = pixels[j];
         let k = match &fast {
             Some(f) if f.certain >> j & 1 == 1 => f.k(j),
             _ => {
                 counts.exact_weights += 1;
                 let e = &input.edges[wedge.edge as usize];
-                match e.sweep_weight(input.origins[i].as_dvec3(), input.c, false) {
+                match e.sweep_weight(input.origins[pixels[j]].as_dvec3(), input.c, false) {
                     Some(k) => k,
                     None => continue,
                 }
             }
         };
         if k != 0 {
-            pair(j, i, k.clamp(i32::MIN as i64, i32::MAX as i64) as i32);
+            ks[j] = k.clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+            nonzero |= 1 << j;
         }
     }
+    (nonzero, ks)
 }
 
 /// The light-plane test of wedge `wi` (`pe`, its edge in light-plane form) from view sample
@@ -1005,10 +1006,9 @@ pub(crate) fn square_pairs(
             // computes in software.
             counts.tile_wedges += 1;
             counts.scanned += u64::from(scan.active);
-            let planar_lanes = scan.planar_lanes;
             let entries = &mut out.entries[t * LANES..(t + 1) * LANES];
             let tests = &mut out.tests[t * LANES..(t + 1) * LANES];
-            tile_pairs(
+            let (pairs, ks) = tile_weights(
                 input,
                 wi,
                 tile,
@@ -1016,33 +1016,37 @@ pub(crate) fn square_pairs(
                 &scan.extent,
                 &scan.pixels,
                 counts,
-                |j, i, k| {
-                    // Read here, not per wedge: a wedge whose tiles give no pair leaves its
-                    // lanes' record untouched.
-                    let pe = input.lanes[wi as usize].planar.as_ref();
-                    match pe.filter(|_| planar_lanes >> j & 1 == 1) {
-                        Some(pe) => match planar_test(
-                            input,
-                            pe,
-                            wi,
-                            i,
-                            Vec3::new(tile.x[j], tile.y[j], tile.z[j]),
-                            tile.l1[j],
-                        ) {
-                            Some(mut t) => {
-                                t.k = k;
-                                tests[j].push(t);
-                            }
-                            None => {
-                                ties += 1;
-                                return;
-                            }
-                        },
-                        None => entries[j].push(Pair { edge: wi, k }),
-                    }
-                    len += 1;
-                },
             );
+            if pairs == 0 {
+                continue;
+            }
+            // Read here, not per wedge: a wedge whose tiles give no pair leaves its lanes'
+            // record untouched. The light-plane form is copied out once for the tile's pairs,
+            // so that its rows stay in registers across them (read pair by pair, they were
+            // loaded again for each).
+            let pe = input.lanes[wi as usize].planar;
+            let planar = if pe.is_some() {
+                pairs & scan.planar_lanes
+            } else {
+                0
+            };
+            for j in lanes_of(pairs & !planar) {
+                entries[j].push(Pair { edge: wi, k: ks[j] });
+                len += 1;
+            }
+            if let (Some(pe), true) = (pe, planar != 0) {
+                for j in lanes_of(planar) {
+                    let pc = Vec3::new(tile.x[j], tile.y[j], tile.z[j]);
+                    match planar_test(input, &pe, wi, scan.pixels[j], pc, tile.l1[j]) {
+                        Some(mut t) => {
+                            t.k = ks[j];
+                            tests[j].push(t);
+                            len += 1;
+                        }
+                        None => ties += 1,
+                    }
+                }
+            }
         }
     }
     out.counts.ties += ties;
