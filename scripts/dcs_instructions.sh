@@ -11,7 +11,8 @@
 # (the `dcs-64` configuration at N samples and the reference on its samples). The cache model
 # is a 48 KiB, 12-way L1 and a 4 MiB, 16-way last level (the documented machine's L1 and L2).
 # Needs valgrind (`apt-get install -y valgrind`); builds the example first. The callgrind
-# files are left in ${CG_OUT:-/tmp} as dcs_cg_1.out and dcs_cg_0.out for `callgrind_annotate`.
+# files are left in ${CG_OUT:-/tmp} as dcs_cg_1.out and dcs_cg_0.out for `callgrind_annotate`;
+# `python3 scripts/dcs_profile.py [--inclusive]` lists the estimate's instructions by function.
 set -euo pipefail
 cache=()
 if [[ ${1:-} == --cache ]]; then

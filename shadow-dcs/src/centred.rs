@@ -144,21 +144,24 @@ impl FastWeight {
 }
 
 /// `k_e` at every lane of a tile, with the mask of lanes whose signs are all certain (lanes
-/// outside it must take the exact weight). Face
-/// weights are at most [`LANE_WEIGHT_MAX`], so that a lane's sum is exact in single precision.
+/// outside it must take the exact weight) and the mask of lanes whose weight is not zero. Face
+/// weights are at most [`LANE_WEIGHT_MAX`], so that a lane's sum is exact in single precision
+/// and converts to an integer exactly.
 pub(crate) struct LaneWeights {
     k: [f32; LANES],
     pub certain: LaneMask,
+    /// Lanes whose `k_e` is not zero (certain or not).
+    pub nonzero: LaneMask,
 }
 
 impl LaneWeights {
     /// `k_e` at lane `j`.
     #[inline]
-    pub fn k(&self, j: usize) -> i64 {
+    pub fn k(&self, j: usize) -> i32 {
         // A whole number of magnitude below `2^22` plus `1.5 * 2^23` keeps itself in the low
         // bits (no saturating conversion): the face weights are at most `2^20`.
         const MAGIC: f32 = 12_582_912.0;
-        i64::from((self.k[j] + MAGIC).to_bits() as i32 - MAGIC.to_bits() as i32)
+        (self.k[j] + MAGIC).to_bits() as i32 - MAGIC.to_bits() as i32
     }
 }
 
@@ -215,10 +218,17 @@ impl FastWeight {
             }
         }
         let mut out = [0.0f32; LANES];
+        let mut nonzero: LaneMask = 0;
         for q in 0..QUADS {
             out[4 * q..4 * q + 4].copy_from_slice(&k[q].to_array());
+            // Whole numbers: zero as floats where zero as integers.
+            nonzero |= (k[q].cmpne(zero).bitmask() as LaneMask) << (4 * q);
         }
-        Some(LaneWeights { k: out, certain })
+        Some(LaneWeights {
+            k: out,
+            certain,
+            nonzero,
+        })
     }
 }
 
@@ -379,10 +389,16 @@ mod tests {
                 .unwrap();
             for (j, p) in points.iter().enumerate() {
                 total += 1;
+                // The scan keeps the lanes of this mask as pairs.
+                assert_eq!(
+                    lanes.nonzero >> j & 1 == 1,
+                    lanes.k(j) != 0,
+                    "case {k} lane {j}: non-zero mask"
+                );
                 if lanes.certain >> j & 1 == 1 {
                     certain += 1;
                     assert_eq!(
-                        Some(lanes.k(j)),
+                        Some(i64::from(lanes.k(j))),
                         edge.sweep_weight(*p, c, false),
                         "case {k} lane {j}"
                     );
@@ -433,6 +449,7 @@ mod tests {
             ) {
                 (Some(a), Some(b)) => {
                     assert_eq!(a.certain, b.certain, "case {k}");
+                    assert_eq!(a.nonzero, b.nonzero, "case {k}");
                     for j in 0..LANES {
                         assert_eq!(a.k(j), b.k(j), "case {k} lane {j}");
                     }
@@ -462,7 +479,7 @@ mod tests {
             let lanes = fast.weight_lanes(&TileLanes::at(pc).quads(), None).unwrap();
             if lanes.certain & 1 == 1 {
                 answered += 1;
-                let k = lanes.k(0);
+                let k = i64::from(lanes.k(0));
                 assert_eq!(Some(k), edge.sweep_weight(p, c, false), "case {k}");
             }
             let centred = CentredEdge::new(&edge, c);
