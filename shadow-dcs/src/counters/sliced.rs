@@ -161,7 +161,7 @@ impl BitSliced {
         }
         let bits = self.bits as usize;
         let planes = &mut self.planes[w * bits..(w + 1) * bits];
-        if k.count_ones() > 2 {
+        if more_than_two_bits(k) {
             // A wide weight (opacity units): one pass of a full adder over the bit words from
             // the weight's lowest bit, `step` taking the weight's bit (`m` or 0) and the carry.
             let mut carry = 0u64;
@@ -241,9 +241,27 @@ impl BitSliced {
     }
 }
 
+/// Whether `k` has more than two bits set: what is left once its lowest two are cleared (no
+/// population count, which this target computes in software, once per update).
+#[inline(always)]
+fn more_than_two_bits(k: u64) -> bool {
+    let above_one = k & k.wrapping_sub(1);
+    above_one & above_one.wrapping_sub(1) != 0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn more_than_two_bits_counts_as_the_population_count() {
+        let mut values: Vec<u64> = vec![0, 1, 2, 3, 4, 5, 6, 7, 8, u64::MAX, 1 << 63, 3 << 62];
+        values.extend((0..64).flat_map(|a| (0..64).map(move |b| (1u64 << a) | (1u64 << b))));
+        values.extend((0..2000u64).map(|i| i.wrapping_mul(0x9e37_79b9_7f4a_7c15) >> (i % 64)));
+        for k in values {
+            assert_eq!(more_than_two_bits(k), k.count_ones() > 2, "{k:#x}");
+        }
+    }
     use crate::counters::WIDTHS;
 
     #[test]
