@@ -872,8 +872,8 @@ impl SquareTiles {
 /// `extent`, the image index of each lane in `pixels`): the fold planes (where the edge may be
 /// a silhouette), then the bounding planes that may cut the tile's box on the view samples
 /// left, then the weights where any is inside, exact where the single-precision signs are
-/// uncertain. Returns the lanes with a non-zero weight (one bit each) and the lanes' weights
-/// (those of the other lanes unspecified).
+/// uncertain. Returns the lanes with a non-zero weight (one bit each) and every lane's weight
+/// (zero outside that mask).
 #[inline]
 pub(crate) fn tile_weights(
     input: &ScanInput,
