@@ -186,6 +186,21 @@ impl LightSampler {
         );
     }
 
+    /// The shared set whose samples pixel `pixel` takes unchanged: set 0 under correlated
+    /// sampling, the set of the pixel's place in its tile under interleaved sampling; `None`
+    /// where each pixel has samples of its own (decorrelated and stratified sampling). Pixels
+    /// with the same shared set have the same [`LightSampler::unit_samples`], so a technique
+    /// may keep whatever it derives from them alone.
+    pub fn shared_set(&self, pixel: UVec2) -> Option<usize> {
+        match self.strategy {
+            SamplingStrategy::Correlated => Some(0),
+            SamplingStrategy::Interleaved { tile } => {
+                Some(((pixel.y % tile) * tile + pixel.x % tile) as usize)
+            }
+            SamplingStrategy::Decorrelated | SamplingStrategy::Stratified => None,
+        }
+    }
+
     /// The unit-square samples of pixel `pixel` (x, y), written into `out` (cleared first).
     pub fn unit_samples(&self, pixel: UVec2, out: &mut Vec<Vec2>) {
         out.clear();
@@ -203,9 +218,9 @@ impl LightSampler {
                 hash_words(&[self.seed, 0x57, pixel.x as u64, pixel.y as u64]),
                 out,
             ),
-            SamplingStrategy::Interleaved { tile } => {
-                let k = (pixel.y % tile) * tile + pixel.x % tile;
-                out.extend_from_slice(&self.sets[k as usize]);
+            SamplingStrategy::Interleaved { .. } => {
+                let k = self.shared_set(pixel).unwrap_or(0);
+                out.extend_from_slice(&self.sets[k]);
             }
         }
     }
@@ -266,6 +281,49 @@ mod tests {
                     assert_eq!(*u, want, "n {n} pixel {pixel} sample {k}");
                 }
             }
+        }
+    }
+
+    /// Pixels with the same shared set get the same samples, pixels with different ones do
+    /// not, and only correlated and interleaved sampling share sets.
+    #[test]
+    fn pixels_of_one_shared_set_have_the_same_samples() {
+        let pixels: Vec<UVec2> = (0..7)
+            .flat_map(|y| (0..9).map(move |x| UVec2::new(x, y)))
+            .collect();
+        let samples = |s: &LightSampler, p: UVec2| {
+            let mut out = Vec::new();
+            s.unit_samples(p, &mut out);
+            out
+        };
+        for strategy in [
+            SamplingStrategy::Correlated,
+            SamplingStrategy::Interleaved { tile: 3 },
+            SamplingStrategy::Interleaved { tile: 1 },
+        ] {
+            let s = LightSampler::new(strategy, 16, 5).unwrap();
+            let sets: std::collections::BTreeSet<usize> =
+                pixels.iter().map(|p| s.shared_set(*p).unwrap()).collect();
+            let want = match strategy {
+                SamplingStrategy::Interleaved { tile } => (tile * tile) as usize,
+                _ => 1,
+            };
+            assert_eq!(sets.len(), want, "{strategy:?}");
+            assert!(sets.iter().all(|k| *k < want));
+            for a in &pixels {
+                for b in &pixels {
+                    let same = s.shared_set(*a) == s.shared_set(*b);
+                    assert_eq!(
+                        samples(&s, *a) == samples(&s, *b),
+                        same,
+                        "{strategy:?} {a} {b}"
+                    );
+                }
+            }
+        }
+        for strategy in [SamplingStrategy::Decorrelated, SamplingStrategy::Stratified] {
+            let s = LightSampler::new(strategy, 16, 5).unwrap();
+            assert!(pixels.iter().all(|p| s.shared_set(*p).is_none()));
         }
     }
 

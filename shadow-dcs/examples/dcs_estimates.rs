@@ -8,7 +8,8 @@
 //! `TECHNIQUE` is a DCS preset name (`dcs-64` by default), `reference` (the reference on the
 //! samples of `dcs-64`: 64 stratified samples, seed 1, as `dcs_bench` compares them), or
 //! `stratified-N` / `reference-N` (the `dcs-64` configuration with `N` stratified samples, and
-//! the reference on the same samples, as `dcs_bench SCENE SIZE N` compares them). Prints the
+//! the reference on the same samples, as `dcs_bench SCENE SIZE N` compares them), or
+//! `interleaved-N` / `reference-interleaved-N` (the same with 4 x 4 interleaved sets). Prints the
 //! best wall time of the runs and, for a DCS preset, the counters of the last one, which tell
 //! two builds apart when they should do the same work (pairs, covered updates).
 
@@ -30,21 +31,32 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .map(|n| n.parse().map_err(|_| format!("{name}: not {prefix}N")))
             .transpose()
     };
-    let mut technique: Box<dyn ShadowTechnique> =
-        match (count("reference-")?, count("stratified-")?) {
-            (Some(n), _) => {
-                let sampler = LightSampler::new(SamplingStrategy::Stratified, n, 1)?;
-                Box::new(Reference::same_samples(sampler))
-            }
-            (None, Some(n)) => Box::new(Dcs::new(n, SamplingStrategy::Stratified, 1)?),
-            (None, None) if name == "reference" => {
-                let sampler = LightSampler::new(SamplingStrategy::Stratified, 64, 1)?;
-                Box::new(Reference::same_samples(sampler))
-            }
-            (None, None) => {
-                (common::preset(name, "`reference`, `reference-N` or `stratified-N`")?.make)(1)
-            }
-        };
+    // `interleaved-N`: 4 x 4 interleaved sets, as the paper samples (section 5).
+    let interleaved = SamplingStrategy::Interleaved { tile: 4 };
+    let mut technique: Box<dyn ShadowTechnique> = if let Some(n) = count("reference-interleaved-")?
+    {
+        Box::new(Reference::same_samples(LightSampler::new(
+            interleaved,
+            n,
+            1,
+        )?))
+    } else if let Some(n) = count("interleaved-")? {
+        Box::new(Dcs::new(n, interleaved, 1)?)
+    } else if let Some(n) = count("reference-")? {
+        let sampler = LightSampler::new(SamplingStrategy::Stratified, n, 1)?;
+        Box::new(Reference::same_samples(sampler))
+    } else if let Some(n) = count("stratified-")? {
+        Box::new(Dcs::new(n, SamplingStrategy::Stratified, 1)?)
+    } else if name == "reference" {
+        let sampler = LightSampler::new(SamplingStrategy::Stratified, 64, 1)?;
+        Box::new(Reference::same_samples(sampler))
+    } else {
+        (common::preset(
+            name,
+            "`reference`, `reference-N`, `stratified-N`, `interleaved-N` or `reference-interleaved-N`",
+        )?
+        .make)(1)
+    };
     technique.prepare(setup.scene.clone(), setup.lights[0].clone())?;
     let (best, last) = common::best_of(runs, technique.as_mut(), &view)?;
     match last {

@@ -69,6 +69,7 @@ mod lanes;
 mod light_shape;
 mod planar;
 mod presets;
+mod shared_sets;
 pub mod technique;
 pub mod wedges;
 

@@ -23,8 +23,11 @@
 //! is dropped without a per-sample test (`wedge-pairs-empty-sector`); with the refined tables
 //! of section 7.3, a pair with many candidates looks its line up in the line table, which
 //! settles every candidate it can (`refined-line-cells`); the texture and opacity paths run only
-//! when the light is textured or the scene semi-opaque, and a pixel whose caller reads only
-//! which samples are visible gets that mask and no per-sample values.
+//! when the light is textured or the scene semi-opaque, a pixel whose caller reads only
+//! which samples are visible gets that mask and no per-sample values, and under correlated or
+//! interleaved sampling the pixels of one shared set take the part of their samples' set-up
+//! that depends on the samples alone from that set, built once (`shared_sets`;
+//! `pixels-shared-sample-sets`, `shared-sample-sets-built`).
 //!
 //! Light samples behind the receiver's tangent plane are occluded, and view samples are offset
 //! off their surface, exactly as the reference does ([`shadow_core::offset`]), so that with the
@@ -43,7 +46,7 @@ use shadow_core::technique::{Capabilities, Processor, SceneRef};
 use shadow_core::view_samples::ViewSample;
 use shadow_core::visibility::{PerSampleVisibility, PixelClass};
 
-use crate::angular::{AngularIndex, BATCH, QuadRanges};
+use crate::angular::{BATCH, QuadRanges};
 use crate::bins::{
     BlockWedges, Rect, SQUARE, ScanCounts, ScanInput, ScanWedge, SquarePairs, SquareScratch,
     WedgeLanes, square_pairs,
@@ -55,7 +58,8 @@ use crate::coverage::{EdgeTest, RelativePolygon, RelativeSamples};
 use crate::discrete::{CoveredSamples, DiscreteTables, LineMasks};
 use crate::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
 use crate::light_shape::LightShape;
-use crate::planar::{PlanarEdge, PlanarSamples, PlanarTest, RectMap};
+use crate::planar::{PlanarEdge, PlanarTest, RectMap};
+use crate::shared_sets::{SampleSet, SetForm, SharedSets};
 use crate::wedges::{FOLD_SLACK, Pair, wedges};
 
 /// What per-sample visibility an estimate returns.
@@ -111,6 +115,9 @@ pub struct Dcs {
     covered: CoveredSamples,
     output: PerSampleOutput,
     forced_bits: Option<u32>,
+    /// Whether pixels of one shared sample set share its set-up ([`crate::shared_sets`]);
+    /// off only in tests, which check the shared set-up against each pixel's own.
+    share_sets: bool,
     prepared: Option<Prepared>,
 }
 
@@ -199,14 +206,15 @@ struct Scratch {
     samples: Vec<LightSample>,
     /// The samples' radiances (textured lights: they weigh eq. 2).
     radiances: Vec<Vec3>,
-    positions: Vec<Vec3>,
     relative: RelativeSamples,
-    angular: AngularIndex,
+    /// The samples' positions, light-plane coordinates and angular index: the pixel's own, or
+    /// a shared set's lent by `shared`.
+    set: SampleSet,
+    /// The shared sample sets met so far (correlated and interleaved sampling).
+    shared: SharedSets,
     polygon: RelativePolygon,
     above: Vec<u64>,
     mask: Vec<u64>,
-    /// The samples in the light plane (the light-plane test).
-    planar_samples: PlanarSamples,
     /// Tests waiting for their candidates, and their weights.
     batch: Vec<EdgeTest>,
     batch_k: Vec<i64>,
@@ -255,6 +263,9 @@ struct Counts {
     scan: ScanCounts,
     pairs: u64,
     off_light: u64,
+    /// Pixels whose samples came from a shared set, and the shared sets built.
+    shared_set_pixels: u64,
+    shared_sets_built: u64,
     sector_empty: u64,
     line_cells: u64,
 }
@@ -273,6 +284,8 @@ impl Counts {
         self.scan.add(&o.scan);
         self.pairs += o.pairs;
         self.off_light += o.off_light;
+        self.shared_set_pixels += o.shared_set_pixels;
+        self.shared_sets_built += o.shared_sets_built;
         self.sector_empty += o.sector_empty;
         self.line_cells += o.line_cells;
     }
@@ -296,6 +309,7 @@ impl Dcs {
             covered: CoveredSamples::Exact,
             output: PerSampleOutput::Bits,
             forced_bits: None,
+            share_sets: true,
             prepared: None,
         })
     }
@@ -591,7 +605,7 @@ impl Dcs {
         debug_assert!(start.planar || tests.is_empty());
         debug_assert!(!start.planar || entries.is_empty());
         if !tests.is_empty() {
-            self.ensure_ready(p, f, i, s, &mut start, scratch);
+            self.ensure_ready(p, f, i, s, &mut start, scratch, counts);
             Self::planar_pairs(tests, indexed, scratch, counts);
         }
         for pair in entries {
@@ -606,7 +620,7 @@ impl Dcs {
                 counts.off_light += 1;
                 continue;
             }
-            self.ensure_ready(p, f, i, s, &mut start, scratch);
+            self.ensure_ready(p, f, i, s, &mut start, scratch, counts);
             if indexed {
                 // Candidates a batch at a time (their sector arithmetic vectorises).
                 scratch.batch.push(test);
@@ -682,7 +696,7 @@ impl Dcs {
             ready: false,
         };
         if horizon == Horizon::Mixed {
-            self.ensure_ready(p, f, i, s, &mut start, scratch);
+            self.ensure_ready(p, f, i, s, &mut start, scratch, counts);
         }
         Some(start)
     }
@@ -696,6 +710,7 @@ impl Dcs {
         s: &ViewSample,
         start: &mut PixelStart,
         scratch: &mut Scratch,
+        counts: &mut Counts,
     ) {
         if !start.ready {
             let all_above = f.horizon[i] == Horizon::Above;
@@ -707,6 +722,7 @@ impl Dcs {
                 all_above,
                 start.planar,
                 scratch,
+                counts,
             );
             start.ready = true;
         }
@@ -850,7 +866,8 @@ impl Dcs {
 
     /// A per-sample pixel's samples: positions, the horizon mask, the samples relative to the
     /// view sample (in the light plane with `planar`), the angular index (`indexed`), and empty
-    /// update lists.
+    /// update lists. What depends on the samples alone comes from the pixel's shared set when
+    /// it has one (correlated and interleaved sampling, [`crate::shared_sets`]), built once.
     #[allow(clippy::too_many_arguments)]
     fn sample_setup(
         &self,
@@ -861,6 +878,7 @@ impl Dcs {
         all_above: bool,
         planar: bool,
         scratch: &mut Scratch,
+        counts: &mut Counts,
     ) {
         let n = self.sampler.count() as usize;
         let words = n.div_ceil(64);
@@ -868,22 +886,46 @@ impl Dcs {
         let light = p.light.as_ref();
         scratch.samples.clear();
         scratch.radiances.clear();
-        scratch.positions.clear();
         // A constant rectangle light wholly above the receiver needs no world positions: the
         // light-plane coordinates are an affine map of the unit samples (positions are still
         // made under debug assertions, to check the horizon).
         let rect = p.rect.as_ref().filter(|_| planar && all_above);
-        if light.is_textured() {
-            // The radiances weigh the visibilities (eq. 2).
-            light.sample_into(&scratch.units, &mut scratch.samples);
-            scratch
-                .positions
-                .extend(scratch.samples.iter().map(|l| l.position));
-            scratch
-                .radiances
-                .extend(scratch.samples.iter().map(|l| l.radiance));
-        } else if rect.is_none() || cfg!(debug_assertions) {
-            light.positions_into(&scratch.units, &mut scratch.positions);
+        let form = match (&p.planar, planar, rect) {
+            (Some(_), true, Some(_)) => SetForm::PlanarRect,
+            (Some(_), true, None) => SetForm::Planar,
+            _ => SetForm::Spatial,
+        };
+        // The radiances of a textured light weigh the visibilities (eq. 2): its pixels set
+        // their samples up themselves.
+        let textured = light.is_textured();
+        let shared = (self.share_sets && !textured)
+            .then(|| self.sampler.shared_set(s.pixel))
+            .flatten();
+        let units = &scratch.units;
+        match shared {
+            Some(k) => {
+                // Built with its index, which the pixels of the set that take one then share.
+                let built = scratch.shared.lend(k, form, &mut scratch.set, |set| {
+                    self.set_up_samples(p, form, units, true, set);
+                });
+                counts.shared_sets_built += u64::from(built);
+                counts.shared_set_pixels += 1;
+            }
+            None => {
+                scratch.shared.restore(&mut scratch.set);
+                scratch.set.positions.clear();
+                if textured {
+                    light.sample_into(units, &mut scratch.samples);
+                    scratch
+                        .set
+                        .positions
+                        .extend(scratch.samples.iter().map(|l| l.position));
+                    scratch
+                        .radiances
+                        .extend(scratch.samples.iter().map(|l| l.radiance));
+                }
+                self.set_up_samples(p, form, units, indexed, &mut scratch.set);
+            }
         }
         // Samples above the horizon (the reference's rule), every one when the whole light is
         // surely above.
@@ -895,42 +937,57 @@ impl Dcs {
             }
             if cfg!(debug_assertions) {
                 let mut check = Vec::new();
-                horizon_mask_into(&scratch.positions, s, origin, &mut check);
+                horizon_mask_into(&scratch.set.positions, s, origin, &mut check);
                 assert_eq!(
                     scratch.above, check,
                     "a light surely above the horizon has a sample below it"
                 );
             }
         } else {
-            horizon_mask_into(&scratch.positions, s, origin, &mut scratch.above);
+            horizon_mask_into(&scratch.set.positions, s, origin, &mut scratch.above);
         }
         scratch.masks.clear();
         scratch.weights.clear();
-        match (&p.planar, planar) {
-            (Some(pl), true) => {
-                match rect {
-                    Some(r) => scratch.planar_samples.set_rect(&scratch.units, r),
-                    None => {
-                        scratch
-                            .planar_samples
-                            .set(&scratch.positions, p.shape.center, pl.u, pl.v);
-                    }
-                }
-                if indexed {
-                    scratch.angular.build_planar(&scratch.planar_samples, n);
-                }
-            }
-            _ => {
-                scratch.relative.set(origin, &scratch.positions);
-                if let (Some(plane), true) = (&p.shape.plane, indexed) {
-                    scratch
-                        .angular
-                        .build(plane, p.shape.center, &scratch.positions);
-                }
-            }
+        if form == SetForm::Spatial {
+            scratch.relative.set(origin, &scratch.set.positions);
         }
         scratch.mask.clear();
         scratch.mask.resize(words, 0);
+    }
+
+    /// What a pixel's samples need of their unit samples `units` alone, in `form`, into `set`:
+    /// the world positions (unless already there, as a textured light's samples put them;
+    /// none for the rectangle form outside debug builds), the light-plane coordinates (the
+    /// light-plane forms) and, with `indexed`, the angular index.
+    fn set_up_samples(
+        &self,
+        p: &Prepared,
+        form: SetForm,
+        units: &[Vec2],
+        indexed: bool,
+        set: &mut SampleSet,
+    ) {
+        let n = units.len();
+        let light = p.light.as_ref();
+        let positions_needed = form != SetForm::PlanarRect || cfg!(debug_assertions);
+        if set.positions.is_empty() && positions_needed {
+            light.positions_into(units, &mut set.positions);
+        }
+        match (form, &p.planar, p.rect.as_ref()) {
+            (SetForm::PlanarRect, Some(_), Some(r)) => set.planar.set_rect(units, r),
+            (SetForm::Planar | SetForm::PlanarRect, Some(pl), _) => {
+                set.planar.set(&set.positions, p.shape.center, pl.u, pl.v);
+            }
+            _ => {
+                if let (Some(plane), true) = (&p.shape.plane, indexed) {
+                    set.angular.build(plane, p.shape.center, &set.positions);
+                }
+                return;
+            }
+        }
+        if indexed {
+            set.angular.build_planar(&set.planar, n);
+        }
     }
 
     /// The samples one pair's edge covers (section 7.3 tables, or the exact test on every
@@ -975,7 +1032,7 @@ impl Dcs {
         let n = scratch.batch.len();
         scratch.batch_candidates.resize(BATCH * words, 0);
         scratch.batch_inner.resize(BATCH * words, 0);
-        let any = scratch.angular.candidates_batch(
+        let any = scratch.set.angular.candidates_batch(
             &scratch.batch,
             &scratch.above,
             &mut scratch.batch_candidates,
@@ -1078,18 +1135,22 @@ impl Dcs {
                 let mut hit = 0u64;
                 if let Some(r) = &ranges {
                     let cand = &mut scratch.batch_candidates;
-                    if !scratch.angular.quad_candidates(r, j, &scratch.above, cand) {
+                    if !scratch
+                        .set
+                        .angular
+                        .quad_candidates(r, j, &scratch.above, cand)
+                    {
                         counts.sector_empty += 1;
                         continue;
                     }
                     for (w, &c) in cand.iter().enumerate() {
-                        let m = test.covered_in(&scratch.planar_samples, w, c);
+                        let m = test.covered_in(&scratch.set.planar, w, c);
                         scratch.mask[w] = m;
                         hit |= m;
                     }
                 } else {
                     for (w, &a) in scratch.above.iter().enumerate() {
-                        let m = test.covered_word(&scratch.planar_samples, w) & a;
+                        let m = test.covered_word(&scratch.set.planar, w) & a;
                         scratch.mask[w] = m;
                         hit |= m;
                     }
@@ -1118,9 +1179,9 @@ impl Dcs {
         let Ok(above) = <[u64; W]>::try_from(&scratch.above[..]) else {
             return false;
         };
-        let samples = &scratch.planar_samples;
+        let samples = &scratch.set.planar;
         let (xs, ys) = (samples.words_x::<W>(), samples.words_y::<W>());
-        let Some(rows) = scratch.angular.rows::<W>() else {
+        let Some(rows) = scratch.set.angular.rows::<W>() else {
             return false;
         };
         let (masks, weights) = (&mut scratch.masks, &mut scratch.weights);
@@ -1578,6 +1639,8 @@ impl ShadowTechnique for Dcs {
         stats.add("wedge-pairs-off-light", counts.off_light);
         stats.add("wedge-pairs-empty-sector", counts.sector_empty);
         stats.add("refined-line-cells", counts.line_cells);
+        stats.add("pixels-shared-sample-sets", counts.shared_set_pixels);
+        stats.add("shared-sample-sets-built", counts.shared_sets_built);
         vis.validate()?;
         Ok(Estimate {
             visibility: vis,
@@ -1619,5 +1682,66 @@ mod tests {
         let mut none: Vec<u64> = Vec::new();
         scatter_squares(&mut none, 1, w as usize, &[(squares[0], vec![7u64])], |v| v);
         assert!(none.is_empty());
+    }
+
+    /// Pixels of a shared sample set (correlated and interleaved sampling) that take its
+    /// set-up from the set built once get exactly the depth complexities of pixels that set
+    /// their samples up themselves, in every form of the set-up: the light-plane test on a
+    /// rectangle light (`bunny`, `contact`) and on a disk (`spot-self-shadow`), the 3D test
+    /// of the refined tables, and pixels whose horizon cuts the light (`large-light-close`).
+    /// Each thread builds each set it meets once per form.
+    #[test]
+    fn shared_sample_sets_give_each_pixels_own_depth_complexities() {
+        let depth = |e: &Estimate| match e.visibility.per_sample() {
+            Some(PerSampleVisibility::Counters { counts, .. }) => counts.clone(),
+            _ => panic!("counters requested"),
+        };
+        let mut lent = 0;
+        for name in ["bunny", "contact", "spot-self-shadow", "large-light-close"] {
+            let setup = shadow_core::scenes::builtin(name).unwrap();
+            let view =
+                ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 64, 48)
+                    .unwrap();
+            for (strategy, covered) in [
+                (
+                    SamplingStrategy::Interleaved { tile: 4 },
+                    CoveredSamples::Exact,
+                ),
+                (
+                    SamplingStrategy::Interleaved { tile: 4 },
+                    CoveredSamples::Refined,
+                ),
+                (SamplingStrategy::Correlated, CoveredSamples::Exact),
+            ] {
+                let run = |share: bool| {
+                    let mut d = Dcs::new(64, strategy, 7)
+                        .unwrap()
+                        .with_covered_samples(covered)
+                        .with_per_sample(PerSampleOutput::Counters);
+                    d.share_sets = share;
+                    d.prepare(setup.scene.clone(), setup.lights[0].clone())
+                        .unwrap();
+                    d.estimate(&view).unwrap()
+                };
+                let (shared, own) = (run(true), run(false));
+                let case = format!("{name} {strategy:?} {covered:?}");
+                assert_eq!(depth(&shared), depth(&own), "{case}");
+                let (pixels, built) = (
+                    shared.stats.counter("pixels-shared-sample-sets"),
+                    shared.stats.counter("shared-sample-sets-built"),
+                );
+                assert_eq!(own.stats.counter("pixels-shared-sample-sets"), 0, "{case}");
+                assert_eq!(pixels, shared.stats.counter("pixels-per-sample"), "{case}");
+                let sets = match strategy {
+                    SamplingStrategy::Interleaved { tile } => u64::from(tile * tile),
+                    _ => 1,
+                };
+                let threads = rayon::current_num_threads() as u64;
+                assert!(built <= sets * 3 * threads, "{case}: {built} sets built");
+                assert!(pixels == 0 || built > 0, "{case}");
+                lent += pixels;
+            }
+        }
+        assert!(lent > 1000, "{lent} pixels took a shared set");
     }
 }
