@@ -7,8 +7,9 @@
 #
 #     scripts/dcs_instructions.sh [--cache] [SCENE] [TECHNIQUE] [SIZE]
 #
-# TECHNIQUE is a DCS preset (default `dcs-64`), `reference`, or `stratified-N` / `reference-N`
-# (the `dcs-64` configuration at N samples and the reference on its samples). The cache model
+# TECHNIQUE is a DCS preset (default `dcs-64`), `reference`, `stratified-N` / `reference-N`
+# (the `dcs-64` configuration at N samples and the reference on its samples), or
+# `interleaved-N` / `reference-interleaved-N` (the same with 4 x 4 interleaved sets). The cache model
 # is a 48 KiB, 12-way L1 and a 4 MiB, 16-way last level (the documented machine's L1 and L2).
 # Needs valgrind (`apt-get install -y valgrind`); builds the example first. The callgrind
 # files are left in ${CG_OUT:-/tmp} as dcs_cg_1.out and dcs_cg_0.out for `callgrind_annotate`;
