@@ -14,6 +14,7 @@
 # Needs valgrind (`apt-get install -y valgrind`); builds the example first. The callgrind
 # files are left in ${CG_OUT:-/tmp} as dcs_cg_1.out and dcs_cg_0.out for `callgrind_annotate`;
 # `python3 scripts/dcs_profile.py [--inclusive]` lists the estimate's instructions by function.
+# `DCS_LIGHT_SCALE=K` in the environment reaches the example: the scene's rectangle light scaled.
 set -euo pipefail
 cache=()
 if [[ ${1:-} == --cache ]]; then

@@ -8,6 +8,9 @@
 //! Prints the best-of-`RUNS` wall time of each (all threads), DCS's phase times and counters of
 //! its last run, the ratio and the per-sample agreement; fails when agreement is below 99.9%
 //! (below the preset's own bound for a named preset: 99% for `dcs-64-discrete`).
+//!
+//! `DCS_LIGHT_SCALE=K` in the environment scales the scene's rectangle light's sides by `K`
+//! (`bunny`'s penumbrae, and with them DCS's pairs, grow with the light).
 
 use shadow_core::prelude::*;
 use shadow_dcs::Dcs;

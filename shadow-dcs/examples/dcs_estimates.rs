@@ -12,6 +12,7 @@
 //! `interleaved-N` / `reference-interleaved-N` (the same with 4 x 4 interleaved sets). Prints the
 //! best wall time of the runs and, for a DCS preset, the counters of the last one, which tell
 //! two builds apart when they should do the same work (pairs, covered updates).
+//! `DCS_LIGHT_SCALE=K` in the environment scales the scene's rectangle light's sides by `K`.
 
 use shadow_core::prelude::*;
 use shadow_dcs::Dcs;

@@ -6,11 +6,34 @@ use std::time::Instant;
 use shadow_core::prelude::*;
 
 /// Built-in scene `name` and its view samples at `size` x `size` from the scene's camera.
+///
+/// With `DCS_LIGHT_SCALE=K` in the environment, a rectangle light's sides are scaled by `K`
+/// about its centre (same plane, same radiance), so that one scene measures how the cost of
+/// both DCS and the reference follows the penumbrae's width; any other light is an error.
 pub fn scene_and_view(
     name: &str,
     size: u32,
 ) -> Result<(SceneSetup, ViewSamples), Box<dyn std::error::Error>> {
-    let setup = shadow_core::scenes::builtin(name)?;
+    let mut setup = shadow_core::scenes::builtin(name)?;
+    if let Ok(k) = std::env::var("DCS_LIGHT_SCALE") {
+        let k: f32 = k
+            .parse()
+            .ok()
+            .filter(|k: &f32| k.is_finite() && *k > 0.0)
+            .ok_or_else(|| format!("DCS_LIGHT_SCALE={k}: not a positive number"))?;
+        let light = &setup.lights[0];
+        let shadow_core::light::LightGeometry::Rectangle {
+            center,
+            half_u,
+            half_v,
+            ..
+        } = light.geometry()
+        else {
+            return Err(format!("DCS_LIGHT_SCALE: {name}'s light is not a rectangle").into());
+        };
+        let scaled = RectLight::new(center, half_u * k, half_v * k, light.radiance().clone())?;
+        setup.lights[0] = std::sync::Arc::new(scaled);
+    }
     let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), size, size)?;
     Ok((setup, view))
 }
