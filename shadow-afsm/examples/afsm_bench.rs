@@ -23,30 +23,32 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), w, h)?;
     let mode = args.get(5).map_or("exact", String::as_str);
     let interleaved = SamplingStrategy::Interleaved { tile: 4 };
-    let mut afsm = match mode {
+    let afsm = match mode {
         "exact" => Afsm::new(n, interleaved, 1)?,
         "stencil" => Afsm::new(n, interleaved, 1)?.with_silhouette_stencil(),
         "lut" => Afsm::new(n, SamplingStrategy::Correlated, 1)?.with_lut()?,
         other => return Err(format!("unknown mode `{other}`: exact, lut or stencil").into()),
     };
-    afsm.prepare(setup.scene.clone(), Arc::clone(&light))?;
-    afsm.estimate(&view)?; // warm-up
+    let afsm_prepared = afsm.prepare_afsm(setup.scene.clone(), Arc::clone(&light))?;
+    afsm_prepared.estimate(&view, Outputs::VISIBILITY)?; // warm-up
     let t0 = Instant::now();
-    let est = afsm.estimate(&view)?;
+    let est = afsm_prepared.estimate(&view, Outputs::VISIBILITY)?;
     let t_afsm = t0.elapsed().as_secs_f64();
-    let mut r = Reference::same_samples(afsm.light_sampler().expect("soft").clone());
-    r.prepare(setup.scene.clone(), Arc::clone(&light))?;
+    let r = Reference::same_samples(afsm.light_sampler().expect("soft").clone());
+    let r_prepared = r.prepare(setup.scene.clone(), Arc::clone(&light))?;
     let t0 = Instant::now();
-    let re = r.estimate(&view)?;
+    let re = r_prepared.estimate(&view, Outputs::VISIBILITY)?;
     let t_ref = t0.elapsed().as_secs_f64();
     let m = compare(&est.visibility, &re.visibility)?;
     // Error against the converged answer (1024 stratified samples): equal for both at equal N.
-    let mut truth = Reference::stratified(1024, 77)?;
-    truth.prepare(setup.scene.clone(), Arc::clone(&light))?;
-    let truth = truth.estimate(&view)?.visibility;
+    let truth = Reference::stratified(1024, 77)?;
+    let truth_prepared = truth.prepare(setup.scene.clone(), Arc::clone(&light))?;
+    let truth = truth_prepared
+        .estimate(&view, Outputs::VISIBILITY)?
+        .visibility;
     let e_afsm = compare(&est.visibility, &truth)?.rmse;
     let e_ref = compare(&re.visibility, &truth)?.rmse;
-    println!("adapter: {}", afsm.adapter().unwrap_or_default());
+    println!("adapter: {}", afsm_prepared.adapter());
     println!(
         "{scene} {w}x{h} N={n} {mode}: afsm {t_afsm:.3} s, reference (same samples, CPU) {t_ref:.3} s, ratio {:.2}",
         t_ref / t_afsm
@@ -60,15 +62,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for p in &est.stats.phases {
         println!("  phase {:<16} {:.4} s", p.name, p.seconds);
     }
-    let occupied = est.stats.counter("lists-occupied");
-    let listed = est.stats.counter("receivers-listed");
-    let side = est.stats.counter("map-side");
+    let occupied = est.stats.counter("lists-occupied").unwrap();
+    let listed = est.stats.counter("receivers-listed").unwrap();
+    let side = est.stats.gauge("map-side").unwrap();
     println!(
         "  lists: {occupied} occupied of {} ({:.1}%), average length {:.2}, longest {}",
         side * side,
         100.0 * occupied as f64 / (side * side) as f64,
         listed as f64 / occupied.max(1) as f64,
-        est.stats.counter("list-length-max")
+        est.stats.gauge("list-length-max").unwrap()
     );
     for k in [
         "pairs-tested",
@@ -79,7 +81,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "texels-visited",
         "silhouette-edges",
     ] {
-        println!("  {k} {}", est.stats.counter(k));
+        println!("  {k} {}", est.stats.counter(k).unwrap_or(0));
     }
     Ok(())
 }

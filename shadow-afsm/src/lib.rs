@@ -23,6 +23,26 @@
 //! `WGPU_BACKEND` and `WGPU_ADAPTER_NAME`, with the software Vulkan adapter (lavapipe) as the
 //! fallback. Without any adapter, `prepare` reports the technique unsupported (or fails when
 //! `SHADOW_REQUIRE_GPU` is set).
+//!
+//! ```
+//! use shadow_afsm::Afsm;
+//! use shadow_core::prelude::*;
+//!
+//! let setup = shadow_core::scenes::builtin("quad-over-plane").unwrap();
+//! let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 24, 18).unwrap();
+//! let afsm = Afsm::new(32, SamplingStrategy::Correlated, 1).unwrap();
+//! match afsm.prepare(setup.scene.clone(), setup.lights[0].clone()) {
+//!     Ok(prepared) => {
+//!         let est = prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
+//!         assert!(est.stats.counter("pairs-tested").unwrap() > 0);
+//!     }
+//!     // Without an adapter (and without `SHADOW_REQUIRE_GPU`), AFSM says why.
+//!     Err(e) => assert!(matches!(
+//!         e.unsupported_reason(),
+//!         Some(UnsupportedReason::NoAdapter(_))
+//!     )),
+//! }
+//! ```
 
 #![deny(missing_docs)]
 
@@ -38,5 +58,5 @@ pub mod technique;
 pub mod temporal;
 
 pub use presets::presets;
-pub use technique::{Afsm, PlaneTest};
+pub use technique::{Afsm, PlaneTest, PreparedAfsm};
 pub use temporal::{TemporalAccumulator, accumulate};

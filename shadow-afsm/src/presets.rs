@@ -53,13 +53,17 @@ pub fn presets() -> Vec<Preset> {
             make: |_| Box::new(Afsm::hard()),
             budget: |s| Budget::lookup(budgets::AFSM_HARD, s),
             with_samples: None,
+            known_limitations: &[],
         },
         Preset {
             name: "afsm-128",
             description: "AFSM soft shadows, 128 samples in 4x4 interleaved sets, exact plane tests",
             make: |seed| exact(128, seed, "afsm-128"),
             budget: |s| tie_budget(128, s),
-            with_samples: Some(|n, seed| exact(n, seed, "afsm")),
+            with_samples: Some(|n, seed| {
+                Ok(Box::new(Afsm::new(n, INTERLEAVED, seed)?.named("afsm")))
+            }),
+            known_limitations: &[],
         },
         Preset {
             name: "afsm-256",
@@ -67,6 +71,7 @@ pub fn presets() -> Vec<Preset> {
             make: |seed| exact(256, seed, "afsm-256"),
             budget: |s| tie_budget(256, s),
             with_samples: None,
+            known_limitations: &[],
         },
         Preset {
             name: "afsm-1024",
@@ -74,6 +79,7 @@ pub fn presets() -> Vec<Preset> {
             make: |seed| exact(1024, seed, "afsm-1024"),
             budget: |s| tie_budget(1024, s),
             with_samples: None,
+            known_limitations: &[],
         },
         Preset {
             name: "afsm-128-lut",
@@ -93,6 +99,7 @@ pub fn presets() -> Vec<Preset> {
                 })
             },
             with_samples: None,
+            known_limitations: &[],
         },
     ]
 }

@@ -170,7 +170,10 @@ pub fn silhouette_edges(scene: &dyn Scene, bounds: &LightBounds) -> Vec<Caster> 
     out
 }
 
-/// Alias-free shadow maps (hard) and sample-based visibility (soft) on wgpu.
+/// Alias-free shadow maps (hard) and sample-based visibility (soft) on wgpu: a configuration
+/// ([`ShadowTechnique::prepare`] or [`Afsm::prepare_afsm`] gives the [`PreparedAfsm`] that
+/// estimates).
+#[derive(Clone)]
 pub struct Afsm {
     name: String,
     samples: u32,
@@ -182,7 +185,21 @@ pub struct Afsm {
     plane_test: PlaneTest,
     stencil: bool,
     memory_limit: Option<u64>,
-    prepared: Option<Prepared>,
+}
+
+/// AFSM prepared for one scene and light: its device, pipelines, casters and light samples.
+pub struct PreparedAfsm {
+    config: Afsm,
+    p: Prepared,
+    stats: Stats,
+}
+
+impl std::fmt::Debug for PreparedAfsm {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PreparedAfsm")
+            .field("config", &self.config)
+            .finish_non_exhaustive()
+    }
 }
 
 impl std::fmt::Debug for Afsm {
@@ -237,7 +254,6 @@ impl Afsm {
             plane_test: PlaneTest::Exact,
             stencil: false,
             memory_limit: None,
-            prepared: None,
         })
     }
 
@@ -293,10 +309,11 @@ impl Afsm {
     }
 
     /// Moves to frame `k` of temporal jittering: frame 0 uses the seed's sets, every other
-    /// frame a fresh set from a hash of the seed and `k` (section 4.2, Fig. 7).
+    /// frame a fresh set from a hash of the seed and `k` (section 4.2, Fig. 7). A prepared
+    /// technique moves with [`PreparedAfsm::set_frame`].
     ///
     /// # Errors
-    /// [`TechniqueError::Device`] when the new samples (and table) cannot be uploaded.
+    /// [`TechniqueError::InvalidInput`] when the sampler cannot be rebuilt.
     pub fn set_frame(&mut self, k: u64) -> Result<(), TechniqueError> {
         let seed = if k == 0 {
             self.seed
@@ -306,12 +323,46 @@ impl Afsm {
         self.frame = k;
         self.sampler = LightSampler::new(self.strategy, self.samples, seed)
             .map_err(|e| TechniqueError::InvalidInput(e.to_string()))?;
-        if let Some(p) = self.prepared.take() {
-            let light = p.light.clone();
-            let scene = p.scene.clone();
-            self.prepared = Some(self.build(scene, light)?);
-        }
         Ok(())
+    }
+
+    /// A GPU failure as a technique error: a missing adapter is
+    /// [`UnsupportedReason::NoAdapter`] (with a loud note) unless the environment requires a
+    /// GPU, when it is a device failure like any other.
+    fn gpu_error(&self, e: GpuError) -> TechniqueError {
+        match e {
+            GpuError::NoAdapter(m) if !gpu_required() => {
+                eprintln!(
+                    "{}: no GPU adapter: {m}; reported as unsupported (set {}=1 to make it a \
+                     failure)",
+                    self.name,
+                    shadow_core::gpu::REQUIRE_GPU_ENV
+                );
+                TechniqueError::unsupported(&self.name, UnsupportedReason::NoAdapter(m))
+            }
+            e => device_error(e),
+        }
+    }
+
+    /// Builds the device data (casters, light samples, tables) for `scene` and `light`.
+    ///
+    /// # Errors
+    /// [`TechniqueError::Unsupported`] outside the capabilities or without an adapter (unless
+    /// one is required); [`TechniqueError::Device`] on a device failure.
+    pub fn prepare_afsm(
+        &self,
+        scene: SceneRef,
+        light: Light,
+    ) -> Result<PreparedAfsm, TechniqueError> {
+        self.capabilities()
+            .require(&self.name, scene.as_ref(), light.as_ref())?;
+        let mut stats = Stats::default();
+        let p = stats.time("prepare", || self.build(scene, light))?;
+        Ok(PreparedAfsm {
+            config: self.clone(),
+            p,
+            stats,
+        })
     }
 
     fn words(&self) -> u32 {
@@ -358,7 +409,7 @@ impl Afsm {
     }
 
     fn build(&self, scene: SceneRef, light: Light) -> Result<Prepared, TechniqueError> {
-        let (gpu, pipes) = Pipelines::shared().map_err(device_error)?;
+        let (gpu, pipes) = Pipelines::shared().map_err(|e| self.gpu_error(e))?;
         let bounds = LightBounds::new(light.as_ref(), self.hard);
         check_finite(&bounds.floats(), "light bounds").map_err(device_error)?;
         let topo = scene.topology();
@@ -460,22 +511,48 @@ impl Afsm {
             sample_positions,
         })
     }
+}
 
-    /// The adapter the technique runs on, once prepared.
-    pub fn adapter(&self) -> Option<String> {
-        self.prepared.as_ref().map(|p| p.gpu.describe())
+impl PreparedAfsm {
+    /// The adapter the technique runs on.
+    pub fn adapter(&self) -> String {
+        self.p.gpu.describe()
     }
 
     /// The sample positions of the current frame (all sets, in set order).
-    pub fn sample_positions(&self) -> Option<&[Vec3]> {
-        self.prepared
-            .as_ref()
-            .map(|p| p.sample_positions.as_slice())
+    pub fn sample_positions(&self) -> &[Vec3] {
+        &self.p.sample_positions
+    }
+
+    /// The current frame of temporal jittering.
+    pub fn frame(&self) -> u64 {
+        self.config.frame
+    }
+
+    /// The configuration, at its current frame.
+    pub fn config(&self) -> &Afsm {
+        &self.config
+    }
+
+    /// Moves to frame `k` of temporal jittering ([`Afsm::set_frame`]) and uploads the new
+    /// samples (and table).
+    ///
+    /// # Errors
+    /// [`TechniqueError::Device`] when the new samples cannot be uploaded.
+    pub fn set_frame(&mut self, k: u64) -> Result<(), TechniqueError> {
+        self.config.set_frame(k)?;
+        self.p = self
+            .config
+            .build(self.p.scene.clone(), self.p.light.clone())?;
+        Ok(())
     }
 
     /// Runs the passes on `view`, keeping the last caster batch's influence regions when
     /// `keep_regions` (for stage tests). Returns the estimate, the receivers, their map frames
     /// and regions per batch.
+    ///
+    /// # Errors
+    /// [`TechniqueError::Device`] on a device failure.
     #[allow(clippy::type_complexity)]
     pub fn run(
         &self,
@@ -489,10 +566,28 @@ impl Afsm {
         ),
         TechniqueError,
     > {
-        let p = self
-            .prepared
-            .as_ref()
-            .ok_or_else(|| TechniqueError::NotPrepared(self.name.clone()))?;
+        self.config.run(&self.p, view, keep_regions)
+    }
+}
+
+impl Afsm {
+    /// Runs the passes on `view`, keeping the last caster batch's influence regions when
+    /// `keep_regions` (for stage tests). Returns the estimate, the receivers, their map frames
+    /// and regions per batch.
+    #[allow(clippy::type_complexity)]
+    fn run(
+        &self,
+        p: &Prepared,
+        view: &ViewSamples,
+        keep_regions: bool,
+    ) -> Result<
+        (
+            Estimate,
+            Vec<Receiver>,
+            Vec<(MapFrame, Vec<Region>, Vec<u32>)>,
+        ),
+        TechniqueError,
+    > {
         let _gpu = p.gpu.exclusive();
         let mut stats = Stats::default();
         let n = self.samples;
@@ -655,19 +750,12 @@ impl Afsm {
         stats.add("caster-batches", p.batches.len() as u64);
         stats.add("silhouette-edges", p.silhouette_count as u64);
         stats.add("lists-occupied", occupied);
-        stats.add("list-length-max", longest);
-        stats.add("map-side", side as u64);
+        stats.gauge_max("list-length-max", longest);
+        stats.gauge_max("map-side", side as u64);
         for (k, name) in TALLIES.iter().enumerate() {
             stats.add(name, tallies[k]);
         }
-        Ok((
-            Estimate {
-                visibility: vis,
-                stats,
-            },
-            receivers,
-            stages,
-        ))
+        Ok((Estimate::new(vis, stats), receivers, stages))
     }
 }
 
@@ -697,7 +785,6 @@ impl ShadowTechnique for Afsm {
             "plane_test": format!("{:?}", self.plane_test),
             "silhouette_stencil": self.stencil && !self.hard && self.samples > 1,
             "lut_bins": (self.plane_test == PlaneTest::Lut).then(|| crate::lut::bins_for(self.samples)),
-            "adapter": self.adapter(),
         })
     }
 
@@ -705,34 +792,45 @@ impl ShadowTechnique for Afsm {
         (!self.hard).then_some(&self.sampler)
     }
 
-    fn prepare(&mut self, scene: SceneRef, light: Light) -> Result<Stats, TechniqueError> {
-        self.capabilities()
-            .check(scene.as_ref(), light.as_ref())
-            .map_err(|reason| TechniqueError::Unsupported {
-                technique: self.name.clone(),
-                reason,
-            })?;
-        let mut stats = Stats::default();
-        let built = stats.time("prepare", || self.build(scene, light));
-        self.prepared = Some(match built {
-            Ok(p) => p,
-            Err(TechniqueError::Device(e)) if !gpu_required() && e.contains("no GPU adapter") => {
-                eprintln!(
-                    "{}: {e}; reported as unsupported (set {}=1 to make it a failure)",
-                    self.name,
-                    shadow_core::gpu::REQUIRE_GPU_ENV
-                );
-                return Err(TechniqueError::Unsupported {
-                    technique: self.name.clone(),
-                    reason: e,
-                });
-            }
-            Err(e) => return Err(e),
-        });
-        Ok(stats)
+    fn prepare(
+        &self,
+        scene: SceneRef,
+        light: Light,
+    ) -> Result<Box<dyn PreparedShadows>, TechniqueError> {
+        Ok(Box::new(self.prepare_afsm(scene, light)?))
+    }
+}
+
+impl PreparedShadows for PreparedAfsm {
+    fn name(&self) -> &str {
+        &self.config.name
     }
 
-    fn estimate(&mut self, view: &ViewSamples) -> Result<Estimate, TechniqueError> {
-        self.run(view, false).map(|(e, _, _)| e)
+    fn preparation(&self) -> &Stats {
+        &self.stats
+    }
+
+    fn estimate(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError> {
+        let (mut est, _, _) = self.run(view, false)?;
+        if outputs.direct {
+            let sampler = self.config.light_sampler().ok_or_else(|| {
+                TechniqueError::unsupported(
+                    &self.config.name,
+                    UnsupportedReason::Configuration(
+                        "hard shadows have no light samples to shade direct light from".into(),
+                    ),
+                )
+            })?;
+            let t0 = std::time::Instant::now();
+            est.direct = Some(shadow_core::technique::direct_from_per_sample(
+                self.p.scene.as_ref(),
+                self.p.light.as_ref(),
+                sampler,
+                view,
+                &est.visibility,
+            )?);
+            est.stats.add_time("direct", t0.elapsed().as_secs_f64());
+        }
+        Ok(est)
     }
 }

@@ -1,12 +1,12 @@
 //! Temporal jittering (section 4.2, Fig. 7): successive frames evaluate rotated sample sets
-//! ([`Afsm::set_frame`]) and their visibility buffers are averaged, converging toward the
+//! ([`PreparedAfsm::set_frame`]) and their visibility buffers are averaged, converging toward the
 //! visibility of all the frames' samples together for a static scene and camera.
 
 use glam::Vec3;
 use shadow_core::prelude::*;
 use shadow_core::visibility::Coefficients;
 
-use crate::technique::Afsm;
+use crate::technique::PreparedAfsm;
 
 /// A running average of visibility buffers.
 #[derive(Debug, Clone, Default)]
@@ -94,14 +94,14 @@ impl TemporalAccumulator {
 /// # Errors
 /// The technique's errors.
 pub fn accumulate(
-    tech: &mut Afsm,
+    tech: &mut PreparedAfsm,
     view: &ViewSamples,
     frames: u64,
 ) -> Result<VisibilityImage, TechniqueError> {
     let mut acc = TemporalAccumulator::new();
     for k in 0..frames {
         tech.set_frame(k)?;
-        acc.add(&tech.estimate(view)?.visibility)?;
+        acc.add(&tech.estimate(view, Outputs::VISIBILITY)?.visibility)?;
     }
     tech.set_frame(0)?;
     acc.average(view)

@@ -30,32 +30,35 @@ fn soft_shadows_agree_with_the_same_samples_reference_on_every_scene() {
         let setup = builtin(name).unwrap();
         let light = setup.lights[0].clone();
         let view = view_of(&setup, 64, 48);
-        let mut afsm = Afsm::new(128, SamplingStrategy::Interleaved { tile: 4 }, 3).unwrap();
-        if let Err(e) = afsm.prepare(setup.scene.clone(), light.clone()) {
-            println!("{name:<22} {e}");
-            assert!(
-                matches!(e, TechniqueError::Unsupported { .. }),
-                "{name}: {e}"
-            );
-            continue;
-        }
-        let est = afsm.estimate(&view).unwrap();
-        let mut r = Reference::same_samples(afsm.light_sampler().unwrap().clone());
-        r.prepare(setup.scene.clone(), Arc::clone(&light)).unwrap();
-        let re = r.estimate(&view).unwrap();
+        let afsm = Afsm::new(128, SamplingStrategy::Interleaved { tile: 4 }, 3).unwrap();
+        let afsm_prepared = match afsm.prepare(setup.scene.clone(), light.clone()) {
+            Ok(p) => p,
+            Err(e) => {
+                println!("{name:<22} {e}");
+                assert!(
+                    matches!(e, TechniqueError::Unsupported { .. }),
+                    "{name}: {e}"
+                );
+                continue;
+            }
+        };
+        let est = afsm_prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
+        let r = Reference::same_samples(afsm.light_sampler().unwrap().clone());
+        let r_prepared = r.prepare(setup.scene.clone(), Arc::clone(&light)).unwrap();
+        let re = r_prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
         let m = compare(&est.visibility, &re.visibility).unwrap();
         let a = m.sample_agreement.unwrap();
         println!(
             "{name:<22} agreement {a:.6} rmse {:.5} max {:.3} lists {} longest {} pairs {} full {} per-sample {} one-sample {} silhouettes {}",
             m.rmse,
             m.max_abs,
-            est.stats.counter("lists-occupied"),
-            est.stats.counter("list-length-max"),
-            est.stats.counter("pairs-tested"),
-            est.stats.counter("pairs-full"),
-            est.stats.counter("pairs-per-sample"),
-            est.stats.counter("pairs-one-sample"),
-            est.stats.counter("silhouette-edges"),
+            est.stats.counter("lists-occupied").unwrap(),
+            est.stats.gauge("list-length-max").unwrap(),
+            est.stats.counter("pairs-tested").unwrap(),
+            est.stats.counter("pairs-full").unwrap(),
+            est.stats.counter("pairs-per-sample").unwrap(),
+            est.stats.counter("pairs-one-sample").unwrap(),
+            est.stats.counter("silhouette-edges").unwrap(),
         );
         if a < 0.999 {
             failures.push(format!("{name}: agreement {a}"));
@@ -80,9 +83,11 @@ fn gpu_stages_equal_their_cpu_computation() {
         let setup = builtin(name).unwrap();
         let light = setup.lights[0].clone();
         let view = view_of(&setup, 48, 36);
-        let mut afsm = Afsm::new(32, SamplingStrategy::Correlated, 5).unwrap();
-        afsm.prepare(setup.scene.clone(), light.clone()).unwrap();
-        let (est, receivers, stages) = afsm.run(&view, true).unwrap();
+        let afsm = Afsm::new(32, SamplingStrategy::Correlated, 5).unwrap();
+        let afsm_prepared = afsm
+            .prepare_afsm(setup.scene.clone(), light.clone())
+            .unwrap();
+        let (est, receivers, stages) = afsm_prepared.run(&view, true).unwrap();
         let (mut texels, mut pairs) = (0u64, 0u64);
         let bounds = LightBounds::new(light.as_ref(), false);
         let topo = setup.scene.topology();
@@ -157,8 +162,12 @@ fn gpu_stages_equal_their_cpu_computation() {
             receivers.len(),
             "{name}: every receiver in one list"
         );
-        assert_eq!(est.stats.counter("texels-visited"), texels, "{name}");
-        assert_eq!(est.stats.counter("pairs-tested"), pairs, "{name}");
+        assert_eq!(
+            est.stats.counter("texels-visited").unwrap(),
+            texels,
+            "{name}"
+        );
+        assert_eq!(est.stats.counter("pairs-tested").unwrap(), pairs, "{name}");
         println!("{name:<20} texels visited {texels}, pairs tested {pairs}");
     }
 }
@@ -176,12 +185,12 @@ fn hard_shadows_agree_with_the_reference_hard_shadow() {
         let setup = builtin(name).unwrap();
         let light = setup.lights[0].clone();
         let view = view_of(&setup, 64, 48);
-        let mut afsm = Afsm::hard();
-        afsm.prepare(setup.scene.clone(), light.clone()).unwrap();
-        let est = afsm.estimate(&view).unwrap();
-        let mut r = Reference::hard();
-        r.prepare(setup.scene.clone(), Arc::clone(&light)).unwrap();
-        let re = r.estimate(&view).unwrap();
+        let afsm = Afsm::hard();
+        let afsm_prepared = afsm.prepare(setup.scene.clone(), light.clone()).unwrap();
+        let est = afsm_prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
+        let r = Reference::hard();
+        let r_prepared = r.prepare(setup.scene.clone(), Arc::clone(&light)).unwrap();
+        let re = r_prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
         let (mut same, mut total) = (0usize, 0usize);
         for i in 0..view.len() {
             if view.is_valid(i) {

@@ -47,10 +47,14 @@ fn floor_scene(meshes: Vec<MeshDesc>, w: u32, h: u32) -> (SceneRef, ViewSamples)
 }
 
 fn stratified_reference(setup: &SceneSetup, view: &ViewSamples) -> VisibilityImage {
-    let mut r = Reference::stratified(1024, 99).unwrap();
-    r.prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
+    let r = Reference::stratified(1024, 99).unwrap();
+    let r_prepared = r
+        .prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
         .unwrap();
-    r.estimate(view).unwrap().visibility
+    r_prepared
+        .estimate(view, Outputs::VISIBILITY)
+        .unwrap()
+        .visibility
 }
 
 /// Fig. 7: accumulating frames of rotated sample sets converges toward the true visibility.
@@ -61,8 +65,9 @@ fn temporal_jittering_converges() {
     }
     let (setup, view) = setup_view("quad-over-plane", 48, 36);
     let truth = stratified_reference(&setup, &view);
-    let mut afsm = Afsm::new(16, SamplingStrategy::Correlated, 4).unwrap();
-    afsm.prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
+    let afsm = Afsm::new(16, SamplingStrategy::Correlated, 4).unwrap();
+    let mut afsm = afsm
+        .prepare_afsm(setup.scene.clone(), Arc::clone(&setup.lights[0]))
         .unwrap();
     let one = accumulate(&mut afsm, &view, 1).unwrap();
     let eight = accumulate(&mut afsm, &view, 8).unwrap();
@@ -88,14 +93,15 @@ fn splitting_under_a_memory_limit_changes_nothing() {
         if let Some(l) = limit {
             a = a.with_memory_limit(l);
         }
-        a.prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
+        let a_prepared = a
+            .prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
             .unwrap();
-        a.estimate(&view).unwrap()
+        a_prepared.estimate(&view, Outputs::VISIBILITY).unwrap()
     };
     let whole = run(None);
     let split = run(Some(16 * 1024));
-    assert!(split.stats.counter("receiver-batches") > 1);
-    assert!(split.stats.counter("caster-batches") > 1);
+    assert!(split.stats.counter("receiver-batches").unwrap() > 1);
+    assert!(split.stats.counter("caster-batches").unwrap() > 1);
     let m = compare(&split.visibility, &whole.visibility).unwrap();
     assert!(m.sample_agreement.unwrap() >= 0.9999, "{m:?}");
 }
@@ -112,9 +118,13 @@ fn lookup_table_is_close_to_the_exact_test() {
         if lut {
             a = a.with_lut().unwrap();
         }
-        a.prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
+        let a_prepared = a
+            .prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
             .unwrap();
-        a.estimate(&view).unwrap().visibility
+        a_prepared
+            .estimate(&view, Outputs::VISIBILITY)
+            .unwrap()
+            .visibility
     };
     let m = compare(&run(true), &run(false)).unwrap();
     println!("LUT vs exact: {m:?}");
@@ -129,15 +139,24 @@ fn textured_light_matches_the_reference_per_channel() {
         return;
     }
     let (setup, view) = setup_view("textured-light", 48, 36);
-    let mut a = Afsm::new(64, SamplingStrategy::Interleaved { tile: 4 }, 6).unwrap();
-    a.prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
+    let a = Afsm::new(64, SamplingStrategy::Interleaved { tile: 4 }, 6).unwrap();
+    let a_prepared = a
+        .prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
         .unwrap();
-    let e = a.estimate(&view).unwrap();
+    let e = a_prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
     assert!(e.visibility.is_rgb());
-    let mut r = Reference::same_samples(a.light_sampler().unwrap().clone());
-    r.prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
+    let r = Reference::same_samples(a.light_sampler().unwrap().clone());
+    let r_prepared = r
+        .prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
         .unwrap();
-    let m = compare(&e.visibility, &r.estimate(&view).unwrap().visibility).unwrap();
+    let m = compare(
+        &e.visibility,
+        &r_prepared
+            .estimate(&view, Outputs::VISIBILITY)
+            .unwrap()
+            .visibility,
+    )
+    .unwrap();
     assert!(
         m.rmse < 1e-4 && m.sample_agreement.unwrap() >= 0.999,
         "{m:?}"
@@ -177,18 +196,21 @@ fn silhouette_stencil_changes_no_bit_and_skips_umbra_work() {
         if stencil {
             a = a.with_silhouette_stencil();
         }
-        a.prepare(scene.clone(), Arc::clone(&light)).unwrap();
-        let est = a.estimate(&view).unwrap();
-        let mut r = Reference::same_samples(a.light_sampler().unwrap().clone());
-        r.prepare(scene.clone(), Arc::clone(&light)).unwrap();
-        let truth = r.estimate(&view).unwrap().visibility;
+        let a_prepared = a.prepare(scene.clone(), Arc::clone(&light)).unwrap();
+        let est = a_prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
+        let r = Reference::same_samples(a.light_sampler().unwrap().clone());
+        let r_prepared = r.prepare(scene.clone(), Arc::clone(&light)).unwrap();
+        let truth = r_prepared
+            .estimate(&view, Outputs::VISIBILITY)
+            .unwrap()
+            .visibility;
         (est, truth)
     };
     let (plain, truth) = run(false);
     let (restricted, _) = run(true);
     let m = compare(&restricted.visibility, &plain.visibility).unwrap();
     let t = compare(&restricted.visibility, &truth).unwrap();
-    let count = |e: &Estimate, k: &str| e.stats.counter(k);
+    let count = |e: &Estimate, k: &str| e.stats.counter(k).expect("AFSM counts it");
     println!(
         "silhouette edges {} of the sphere's; per-sample pairs {} -> {}, one-sample pairs {}; \
          agreement with the plain run {:.6}, with the reference {:.6}",
@@ -221,16 +243,25 @@ fn semi_opaque_transmittance_matches_the_reference_with_the_stencil() {
         return;
     }
     let (setup, view) = setup_view("semi-opaque", 48, 36);
-    let mut a = Afsm::new(64, SamplingStrategy::Interleaved { tile: 2 }, 6)
+    let a = Afsm::new(64, SamplingStrategy::Interleaved { tile: 2 }, 6)
         .unwrap()
         .with_silhouette_stencil();
-    a.prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
+    let a_prepared = a
+        .prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
         .unwrap();
-    let est = a.estimate(&view).unwrap();
-    let mut r = Reference::same_samples(a.light_sampler().unwrap().clone());
-    r.prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
+    let est = a_prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
+    let r = Reference::same_samples(a.light_sampler().unwrap().clone());
+    let r_prepared = r
+        .prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
         .unwrap();
-    let m = compare(&est.visibility, &r.estimate(&view).unwrap().visibility).unwrap();
+    let m = compare(
+        &est.visibility,
+        &r_prepared
+            .estimate(&view, Outputs::VISIBILITY)
+            .unwrap()
+            .visibility,
+    )
+    .unwrap();
     println!("{m:?}");
     assert!(m.rmse < 1e-4 && m.max_abs < 1e-3, "{m:?}");
     assert!(m.sample_agreement.unwrap() >= 0.999, "{m:?}");
@@ -258,12 +289,15 @@ fn optical_depth_sums_saturate_instead_of_wrapping() {
         .collect();
     let (scene, view) = floor_scene(panels, 32, 24);
     let light = square_light(0.5, 3.0);
-    let mut a = Afsm::new(32, SamplingStrategy::Correlated, 2).unwrap();
-    a.prepare(scene.clone(), Arc::clone(&light)).unwrap();
-    let est = a.estimate(&view).unwrap();
-    let mut r = Reference::same_samples(a.light_sampler().unwrap().clone());
-    r.prepare(scene, light).unwrap();
-    let truth = r.estimate(&view).unwrap().visibility;
+    let a = Afsm::new(32, SamplingStrategy::Correlated, 2).unwrap();
+    let a_prepared = a.prepare(scene.clone(), Arc::clone(&light)).unwrap();
+    let est = a_prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
+    let r = Reference::same_samples(a.light_sampler().unwrap().clone());
+    let r_prepared = r.prepare(scene, light).unwrap();
+    let truth = r_prepared
+        .estimate(&view, Outputs::VISIBILITY)
+        .unwrap()
+        .visibility;
     let m = compare(&est.visibility, &truth).unwrap();
     let umbra = (0..view.len())
         .filter(|&i| view.is_valid(i) && truth.value(i) == 0.0)
@@ -293,12 +327,19 @@ fn polygon_light_agrees_with_the_same_samples_reference() {
         .collect();
     let light: Light =
         Arc::new(PolygonLight::new(outline, Radiance::constant(Vec3::ONE).unwrap()).unwrap());
-    let mut a = Afsm::new(256, SamplingStrategy::Interleaved { tile: 2 }, 9).unwrap();
-    a.prepare(scene.clone(), Arc::clone(&light)).unwrap();
-    let est = a.estimate(&view).unwrap();
-    let mut r = Reference::same_samples(a.light_sampler().unwrap().clone());
-    r.prepare(scene, light).unwrap();
-    let m = compare(&est.visibility, &r.estimate(&view).unwrap().visibility).unwrap();
+    let a = Afsm::new(256, SamplingStrategy::Interleaved { tile: 2 }, 9).unwrap();
+    let a_prepared = a.prepare(scene.clone(), Arc::clone(&light)).unwrap();
+    let est = a_prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
+    let r = Reference::same_samples(a.light_sampler().unwrap().clone());
+    let r_prepared = r.prepare(scene, light).unwrap();
+    let m = compare(
+        &est.visibility,
+        &r_prepared
+            .estimate(&view, Outputs::VISIBILITY)
+            .unwrap()
+            .visibility,
+    )
+    .unwrap();
     println!("{m:?}");
     assert!(m.sample_agreement.unwrap() >= 0.999, "{m:?}");
     assert!(m.rmse < 0.004, "{m:?}");

@@ -64,7 +64,9 @@ pub mod visibility;
 pub use camera::Camera;
 pub use light::{AreaLight, Light, LightSample};
 pub use scene::{Scene, TriangleScene};
-pub use technique::{ShadowTechnique, Stats, TechniqueError};
+pub use technique::{
+    Outputs, PreparedShadows, ShadowTechnique, Stats, TechniqueError, UnsupportedReason,
+};
 pub use view_samples::ViewSamples;
 pub use visibility::{VisibilityBuffer, VisibilityImage};
 
@@ -81,7 +83,8 @@ pub mod prelude {
     pub use crate::sampling::{LightSampler, SamplingStrategy};
     pub use crate::scene::{MeshDesc, Scene, SceneBuilder, TriangleScene};
     pub use crate::technique::{
-        Capabilities, Estimate, Processor, SceneRef, ShadowTechnique, Stats, TechniqueError,
+        Capabilities, Estimate, Outputs, PreparedShadows, Processor, SceneRef, ShadowTechnique,
+        Stats, TechniqueError, UnsupportedReason,
     };
     pub use crate::view_samples::ViewSamples;
     pub use crate::visibility::{

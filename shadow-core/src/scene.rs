@@ -8,6 +8,11 @@ use thiserror::Error;
 use crate::geometry::{Aabb, triangle_cross_f64, triangle_normal};
 use crate::topology::Topology;
 
+/// The largest coordinate magnitude a scene may hold: two points within it are at most
+/// `3.5e18` apart, whose square (`1.2e37`) stays inside `f32`'s range, so bounds, ray lengths
+/// and offsets never overflow to infinity.
+pub const MAX_COORDINATE: f32 = 1e18;
+
 /// Why a scene was rejected.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum SceneError {
@@ -21,6 +26,20 @@ pub enum SceneError {
         index: usize,
         /// The offending position.
         value: [f32; 3],
+    },
+    /// A vertex coordinate is so large that squared distances between scene points overflow
+    /// `f32` (the BVH's bounds, ray lengths and offsets all square them).
+    #[error(
+        "vertex {index} at {value:?} is beyond the largest supported coordinate magnitude \
+         {limit:e} (squared distances would overflow single precision)"
+    )]
+    CoordinateTooLarge {
+        /// Vertex index.
+        index: usize,
+        /// The offending position.
+        value: [f32; 3],
+        /// [`MAX_COORDINATE`].
+        limit: f32,
     },
     /// A triangle refers to a vertex that does not exist.
     #[error(
@@ -438,6 +457,16 @@ impl SceneBuilder {
                 });
             }
         }
+        // After the non-finite check, so that an overflowed transform reads as one.
+        for (i, p) in positions.iter().enumerate() {
+            if p.abs().max_element() > MAX_COORDINATE {
+                return Err(SceneError::CoordinateTooLarge {
+                    index: i,
+                    value: p.to_array(),
+                    limit: MAX_COORDINATE,
+                });
+            }
+        }
         for (t, &o) in opacities.iter().enumerate() {
             if !(0.0..=1.0).contains(&o) {
                 return Err(SceneError::InvalidOpacity {
@@ -539,6 +568,24 @@ mod tests {
         assert_eq!(s.topology().boundary_edges().count(), 4);
         assert!(!s.is_closed_at(0));
         assert!((s.geometric_normal(0) - Vec3::Z).length() < 1e-6);
+    }
+
+    /// Issue 51, item 4: a coordinate above about 1e20 made the BVH's bounds overflow and
+    /// panic downstream; the scene refuses it with the limit in the message.
+    #[test]
+    fn coordinates_beyond_the_supported_magnitude_are_refused() {
+        let (p, t) = quad();
+        let mut far = p.clone();
+        far[3] = Vec3::new(0.0, 1e20, 0.0);
+        let e = TriangleScene::new(far, t.clone()).unwrap_err();
+        assert!(
+            matches!(e, SceneError::CoordinateTooLarge { index: 3, .. }),
+            "{e}"
+        );
+        assert!(e.to_string().contains("1e18"), "{e}");
+        let mut edge = p.clone();
+        edge[3] = Vec3::new(0.0, MAX_COORDINATE, 0.0);
+        assert!(TriangleScene::new(edge, t).is_ok());
     }
 
     #[test]

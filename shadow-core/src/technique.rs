@@ -5,6 +5,7 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 use std::time::Instant;
 
+use glam::Vec3;
 use serde::Serialize;
 use thiserror::Error;
 
@@ -18,6 +19,54 @@ use crate::visibility::{VisibilityError, VisibilityImage};
 /// A scene shared between the caller and the techniques that keep it.
 pub type SceneRef = Arc<dyn Scene>;
 
+/// Why a technique cannot handle an input, by kind: callers branch on the kind (a missing GPU
+/// adapter is a skip outside CI, a light kind is a gap in the capability table), the message
+/// says the rest.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub enum UnsupportedReason {
+    /// The light's shape is outside the technique's capabilities (or, with a message, a light
+    /// the shape allows but the technique cannot sample, such as a point light for DCS).
+    Light {
+        /// The light's kind.
+        kind: LightKind,
+        /// What is missing, beyond the kind.
+        detail: Option<String>,
+    },
+    /// The scene has semi-opaque occluders.
+    SemiOpaque,
+    /// The light is textured.
+    TexturedLight,
+    /// The scene has open meshes and the technique needs closed ones.
+    OpenMeshes,
+    /// The view cannot be handled (for example an orthographic camera).
+    View(String),
+    /// No GPU adapter was found.
+    NoAdapter(String),
+    /// The input exceeds a limit of the device.
+    DeviceLimit(String),
+    /// The technique's configuration cannot handle this input (for example tables that need a
+    /// finite number of sample sets).
+    Configuration(String),
+}
+
+impl std::fmt::Display for UnsupportedReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Light { kind, detail: None } => write!(f, "{kind:?} lights are not supported"),
+            Self::Light {
+                detail: Some(d), ..
+            } => f.write_str(d),
+            Self::SemiOpaque => f.write_str("semi-opaque occluders are not supported"),
+            Self::TexturedLight => f.write_str("textured lights are not supported"),
+            Self::OpenMeshes => {
+                f.write_str("the scene has open meshes and the technique needs closed ones")
+            }
+            Self::View(m) | Self::DeviceLimit(m) | Self::Configuration(m) => f.write_str(m),
+            Self::NoAdapter(m) => write!(f, "no GPU adapter: {m}"),
+        }
+    }
+}
+
 /// Why a technique produced no buffer.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum TechniqueError {
@@ -26,12 +75,9 @@ pub enum TechniqueError {
     Unsupported {
         /// Technique name.
         technique: String,
-        /// Why.
-        reason: String,
+        /// Why, by kind.
+        reason: UnsupportedReason,
     },
-    /// `estimate` was called before `prepare`.
-    #[error("{0}: estimate called before prepare")]
-    NotPrepared(String),
     /// The input is invalid (the caller's fault).
     #[error("invalid input: {0}")]
     InvalidInput(String),
@@ -44,6 +90,30 @@ pub enum TechniqueError {
     /// A GPU device or resource problem.
     #[error("device: {0}")]
     Device(String),
+}
+
+impl From<crate::sampling::SamplingError> for TechniqueError {
+    fn from(e: crate::sampling::SamplingError) -> Self {
+        Self::InvalidInput(e.to_string())
+    }
+}
+
+impl TechniqueError {
+    /// [`TechniqueError::Unsupported`] for `technique`.
+    pub fn unsupported(technique: &str, reason: UnsupportedReason) -> Self {
+        Self::Unsupported {
+            technique: technique.to_string(),
+            reason,
+        }
+    }
+
+    /// The reason, when the technique does not support the input.
+    pub fn unsupported_reason(&self) -> Option<&UnsupportedReason> {
+        match self {
+            Self::Unsupported { reason, .. } => Some(reason),
+            _ => None,
+        }
+    }
 }
 
 /// Where a technique runs.
@@ -76,22 +146,36 @@ impl Capabilities {
     /// `Ok` when the technique can handle `scene` lit by `light`, else the reason.
     ///
     /// # Errors
-    /// The reason, as text, for the first unsupported feature.
-    pub fn check(&self, scene: &dyn Scene, light: &dyn AreaLight) -> Result<(), String> {
+    /// The first unsupported feature.
+    pub fn check(&self, scene: &dyn Scene, light: &dyn AreaLight) -> Result<(), UnsupportedReason> {
         let kind = light.kind();
         if !self.lights.contains(&kind) {
-            return Err(format!("{kind:?} lights are not supported"));
+            return Err(UnsupportedReason::Light { kind, detail: None });
         }
         if light.is_textured() && !self.textured_lights {
-            return Err("textured lights are not supported".into());
+            return Err(UnsupportedReason::TexturedLight);
         }
         if scene.has_semi_opaque() && !self.semi_opaque {
-            return Err("semi-opaque occluders are not supported".into());
+            return Err(UnsupportedReason::SemiOpaque);
         }
         if self.needs_closed_meshes && !scene.topology().all_closed() {
-            return Err("the scene has open meshes and the technique needs closed ones".into());
+            return Err(UnsupportedReason::OpenMeshes);
         }
         Ok(())
+    }
+
+    /// [`Capabilities::check`] as a [`TechniqueError`] naming `technique`.
+    ///
+    /// # Errors
+    /// [`TechniqueError::Unsupported`] with the first unsupported feature.
+    pub fn require(
+        &self,
+        technique: &str,
+        scene: &dyn Scene,
+        light: &dyn AreaLight,
+    ) -> Result<(), TechniqueError> {
+        self.check(scene, light)
+            .map_err(|reason| TechniqueError::unsupported(technique, reason))
     }
 }
 
@@ -104,16 +188,20 @@ pub struct Phase {
     pub seconds: f64,
 }
 
-/// Per-phase times and counters of work done and skipped.
+/// Per-phase times, counters of work done and skipped, and gauges.
 ///
-/// Counters saturate at `u64::MAX` and record the saturation in `saturated`, so they never wrap
-/// silently.
+/// Counters are amounts (rays, pixels, pairs): they add up when stats merge, saturate at
+/// `u64::MAX` and record the saturation in `saturated`, so they never wrap silently. Gauges are
+/// levels (a largest value, a width chosen, a map's side): merging keeps the larger. Looking a
+/// name up gives `None` when it was never recorded, so a test on a renamed counter fails.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct Stats {
     /// Phases in the order they ran.
     pub phases: Vec<Phase>,
     /// Named counters.
     pub counters: BTreeMap<String, u64>,
+    /// Named gauges.
+    pub gauges: BTreeMap<String, u64>,
     /// Counters that saturated.
     pub saturated: Vec<String>,
 }
@@ -123,15 +211,19 @@ impl Stats {
     pub fn time<T>(&mut self, name: &str, f: impl FnOnce() -> T) -> T {
         let t0 = Instant::now();
         let r = f();
-        let s = t0.elapsed().as_secs_f64();
+        self.add_time(name, t0.elapsed().as_secs_f64());
+        r
+    }
+
+    /// Adds `seconds` to phase `name`.
+    pub fn add_time(&mut self, name: &str, seconds: f64) {
         match self.phases.iter_mut().find(|p| p.name == name) {
-            Some(p) => p.seconds += s,
+            Some(p) => p.seconds += seconds,
             None => self.phases.push(Phase {
                 name: name.to_string(),
-                seconds: s,
+                seconds,
             }),
         }
-        r
     }
 
     /// Adds `n` to counter `name`, saturating (and recording it) on overflow.
@@ -148,21 +240,35 @@ impl Stats {
         }
     }
 
+    /// Raises gauge `name` to `v` (a gauge keeps the largest value recorded).
+    pub fn gauge_max(&mut self, name: &str, v: u64) {
+        let g = self.gauges.entry(name.to_string()).or_insert(v);
+        *g = (*g).max(v);
+    }
+
     /// Total time over all phases.
     pub fn total_seconds(&self) -> f64 {
         self.phases.iter().map(|p| p.seconds).sum()
     }
 
-    /// Merges another set of stats (times and counters add up).
+    /// Seconds of phase `name`, when it ran.
+    pub fn phase_seconds(&self, name: &str) -> Option<f64> {
+        self.phases
+            .iter()
+            .find(|p| p.name == name)
+            .map(|p| p.seconds)
+    }
+
+    /// Merges another set of stats: times and counters add up, gauges keep the larger.
     pub fn merge(&mut self, other: &Stats) {
         for p in &other.phases {
-            match self.phases.iter_mut().find(|q| q.name == p.name) {
-                Some(q) => q.seconds += p.seconds,
-                None => self.phases.push(p.clone()),
-            }
+            self.add_time(&p.name, p.seconds);
         }
         for (k, v) in &other.counters {
             self.add(k, *v);
+        }
+        for (k, v) in &other.gauges {
+            self.gauge_max(k, *v);
         }
         for s in &other.saturated {
             if !self.saturated.contains(s) {
@@ -171,10 +277,44 @@ impl Stats {
         }
     }
 
-    /// Counter value (0 when absent).
-    pub fn counter(&self, name: &str) -> u64 {
-        self.counters.get(name).copied().unwrap_or(0)
+    /// Counter `name`, or `None` when it was never recorded.
+    pub fn counter(&self, name: &str) -> Option<u64> {
+        self.counters.get(name).copied()
     }
+
+    /// Gauge `name`, or `None` when it was never recorded.
+    pub fn gauge(&self, name: &str) -> Option<u64> {
+        self.gauges.get(name).copied()
+    }
+}
+
+/// What a caller wants from an estimate beyond `V(p)`.
+///
+/// Asking only for what is read saves memory and time: per-sample visibility is
+/// `ceil(N / 64)` words per pixel, and direct illumination one more pass over the samples.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct Outputs {
+    /// Per-sample visibility in the buffer (sample-based techniques; a technique whose
+    /// configuration already returns it, or returns counters, keeps doing so), read with
+    /// [`crate::visibility::VisibilityBuffer::per_sample`].
+    pub per_sample: bool,
+    /// Direct illumination (DCS eq. 6) in [`Estimate::direct`], from the technique's own
+    /// per-sample visibility (sample-based techniques; the others answer
+    /// [`UnsupportedReason::Configuration`]).
+    pub direct: bool,
+}
+
+impl Outputs {
+    /// `V(p)` alone.
+    pub const VISIBILITY: Self = Self {
+        per_sample: false,
+        direct: false,
+    };
+    /// `V(p)` and per-sample visibility.
+    pub const PER_SAMPLE: Self = Self {
+        per_sample: true,
+        direct: false,
+    };
 }
 
 /// A technique's answer: the visibility buffer and what it cost.
@@ -182,26 +322,42 @@ impl Stats {
 pub struct Estimate {
     /// Visibility per pixel.
     pub visibility: VisibilityImage,
+    /// Outgoing radiance per pixel under diffuse shading (DCS eq. 6), background black, when
+    /// [`Outputs::direct`] asked for it.
+    pub direct: Option<Vec<Vec3>>,
     /// Times and counters of this estimate.
     pub stats: Stats,
 }
 
-/// A soft-shadow technique.
+impl Estimate {
+    /// An estimate of `visibility` alone.
+    pub fn new(visibility: VisibilityImage, stats: Stats) -> Self {
+        Self {
+            visibility,
+            direct: None,
+            stats,
+        }
+    }
+}
+
+/// A soft-shadow technique: a configuration that prepares a scene and light.
 ///
 /// Object-safe so that suites and tools hold `Vec<Box<dyn ShadowTechnique>>`; construction
-/// (presets, parameters) lives on the concrete types.
+/// (presets, parameters) lives on the concrete types, and a configuration that cannot work
+/// is refused there.
 ///
 /// Contract:
-/// * `prepare` is called once per scene and light, `estimate` any number of times after it.
+/// * `prepare` builds everything per scene and light and returns it as a [`PreparedShadows`],
+///   whose `estimate` may be called any number of times; there is no "not prepared" state.
 /// * `estimate` returns a buffer of the view's size whose background pixels are invalid and
 ///   whose valid pixels hold `V(p)` in [0, 1] (RGB non-negative for textured lights), never NaN.
 /// * For a fixed seed the output is identical whatever the thread count.
-/// * Input the technique cannot handle gives [`TechniqueError::Unsupported`] with the reason,
-///   never a silently wrong image.
+/// * Input the technique cannot handle gives [`TechniqueError::Unsupported`] with a typed
+///   reason, never a silently wrong image.
 pub trait ShadowTechnique: Send + Sync {
     /// Preset name, e.g. `ref` or `dcs-64`.
     fn name(&self) -> &str;
-    /// What the technique handles.
+    /// What the technique handles, from its configuration.
     fn capabilities(&self) -> Capabilities;
     /// Parameters for reports (`stats.json`).
     fn parameters(&self) -> serde_json::Value {
@@ -215,12 +371,74 @@ pub trait ShadowTechnique: Send + Sync {
     ///
     /// # Errors
     /// [`TechniqueError::Unsupported`] when the scene or light is outside the capabilities.
-    fn prepare(&mut self, scene: SceneRef, light: Light) -> Result<Stats, TechniqueError>;
-    /// Computes the visibility of every view sample.
+    fn prepare(
+        &self,
+        scene: SceneRef,
+        light: Light,
+    ) -> Result<Box<dyn PreparedShadows>, TechniqueError>;
+}
+
+/// A technique prepared for one scene and light.
+pub trait PreparedShadows: Send + Sync + std::fmt::Debug {
+    /// The technique's name.
+    fn name(&self) -> &str;
+    /// Times and counters of the preparation.
+    fn preparation(&self) -> &Stats;
+    /// Computes the visibility of every view sample, and what `outputs` asks for besides.
     ///
     /// # Errors
-    /// [`TechniqueError::NotPrepared`] before `prepare`; others as the technique documents.
-    fn estimate(&mut self, view: &ViewSamples) -> Result<Estimate, TechniqueError>;
+    /// As the technique documents (unsupported views, device failures).
+    fn estimate(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError>;
+}
+
+/// Direct illumination of every view sample (DCS eq. 6) from a sample-based technique's
+/// per-sample visibility: the light samples of `sampler` at each pixel, weighted by their
+/// binary visibility. This is how every sample-based technique answers [`Outputs::direct`],
+/// so that shading differs between techniques only where their visibility does.
+///
+/// # Errors
+/// [`TechniqueError::InvalidInput`] when `visibility` has no per-sample data of the sampler's
+/// count for the view's pixels.
+pub fn direct_from_per_sample(
+    scene: &dyn Scene,
+    light: &dyn AreaLight,
+    sampler: &LightSampler,
+    view: &ViewSamples,
+    visibility: &VisibilityImage,
+) -> Result<Vec<Vec3>, TechniqueError> {
+    use crate::visibility::VisibilityBuffer;
+    use rayon::prelude::*;
+    let per = visibility.per_sample().ok_or_else(|| {
+        TechniqueError::InvalidInput("direct illumination needs per-sample visibility".into())
+    })?;
+    if per.samples() != sampler.count() || per.pixels() != view.len() {
+        return Err(TechniqueError::InvalidInput(format!(
+            "per-sample visibility holds {} samples for {} pixels; the sampler draws {} for {}",
+            per.samples(),
+            per.pixels(),
+            sampler.count(),
+            view.len()
+        )));
+    }
+    let w = view.width() as usize;
+    let mut out = vec![Vec3::ZERO; view.len()];
+    out.par_chunks_mut(w.max(1))
+        .enumerate()
+        .for_each(|(row, line)| {
+            let (mut units, mut samples) = (Vec::new(), Vec::new());
+            for (x, px) in line.iter_mut().enumerate() {
+                let i = row * w + x;
+                let Some(s) = view.get(i) else { continue };
+                sampler.unit_samples(s.pixel, &mut units);
+                samples.clear();
+                light.sample_into(&units, &mut samples);
+                let albedo = scene.albedo(s.triangle as usize);
+                *px = crate::direct::pixel_direct(&s, albedo, light, &samples, |k| {
+                    if per.visible(i, k as u32) { 1.0 } else { 0.0 }
+                });
+            }
+        });
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -232,10 +450,43 @@ mod tests {
         let mut s = Stats::default();
         s.add("rays", u64::MAX - 1);
         s.add("rays", 5);
-        assert_eq!(s.counter("rays"), u64::MAX);
+        assert_eq!(s.counter("rays"), Some(u64::MAX));
+        assert_eq!(s.counter("ray"), None);
         assert_eq!(s.saturated, vec!["rays".to_string()]);
         let v = s.time("phase", || 3);
         assert_eq!(v, 3);
         assert_eq!(s.phases.len(), 1);
+    }
+
+    #[test]
+    fn gauges_keep_the_largest_value_on_merge() {
+        let (mut a, mut b) = (Stats::default(), Stats::default());
+        a.gauge_max("counter-bits", 16);
+        a.add("pixels", 3);
+        b.gauge_max("counter-bits", 8);
+        b.add("pixels", 4);
+        a.merge(&b);
+        assert_eq!(a.gauge("counter-bits"), Some(16));
+        assert_eq!(a.counter("pixels"), Some(7));
+        assert_eq!(a.counter("counter-bits"), None);
+    }
+
+    #[test]
+    fn unsupported_reasons_read_as_before() {
+        let e = TechniqueError::unsupported(
+            "x",
+            UnsupportedReason::Light {
+                kind: LightKind::Sphere,
+                detail: None,
+            },
+        );
+        assert_eq!(
+            e.to_string(),
+            "x does not support this input: Sphere lights are not supported"
+        );
+        assert!(matches!(
+            e.unsupported_reason(),
+            Some(UnsupportedReason::Light { .. })
+        ));
     }
 }

@@ -537,3 +537,42 @@ fn concave_planar_emitter_becomes_a_polygon_light_and_holes_are_refused() {
         other => panic!("expected Unsupported, got {other:?}"),
     }
 }
+
+/// Issue 51, item 2: a bufferView or accessor `byteOffset` near 2^64 wrapped the bounds
+/// check (`offset + length`) and panicked; it is an error.
+#[test]
+fn offsets_near_two_to_the_64_are_errors_not_panics() {
+    let near = u64::MAX - 7;
+    let mut doc = test_document();
+    doc["bufferViews"][0]["byteOffset"] = json!(near);
+    assert!(load(&doc).is_err());
+    let mut doc = test_document();
+    doc["accessors"][0]["byteOffset"] = json!(near);
+    assert!(load(&doc).is_err());
+    // An image's buffer view as well.
+    let mut doc = test_document();
+    let view = doc["images"][0]["bufferView"].as_u64().unwrap() as usize;
+    doc["bufferViews"][view]["byteOffset"] = json!(near);
+    assert!(load(&doc).is_err());
+}
+
+/// Issue 51, item 3: a primitive whose POSITION (or another attribute, its indices or its
+/// material) names a missing accessor panicked inside gltf-json's validation; it is an error
+/// naming what is missing.
+#[test]
+fn a_primitive_naming_a_missing_accessor_is_an_error() {
+    for field in ["POSITION", "NORMAL"] {
+        let mut doc = test_document();
+        doc["meshes"][0]["primitives"][0]["attributes"][field] = json!(9999);
+        match load(&doc) {
+            Err(LoadError::Missing(m)) => assert!(m.contains("9999"), "{m}"),
+            other => panic!("{field}: {other:?}"),
+        }
+    }
+    let mut doc = test_document();
+    doc["meshes"][0]["primitives"][0]["indices"] = json!(4242);
+    assert!(matches!(load(&doc), Err(LoadError::Missing(m)) if m.contains("4242")));
+    let mut doc = test_document();
+    doc["meshes"][0]["primitives"][0]["material"] = json!(77);
+    assert!(matches!(load(&doc), Err(LoadError::Missing(m)) if m.contains("77")));
+}

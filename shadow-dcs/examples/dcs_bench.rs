@@ -27,7 +27,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (setup, view) = common::scene_and_view(scene, size)?;
     let light = setup.lights[0].clone();
     let mut min_agreement = 0.999;
-    let mut dcs: Box<dyn ShadowTechnique> = match samples.parse::<u32>() {
+    let dcs: Box<dyn ShadowTechnique> = match samples.parse::<u32>() {
         Ok(n) => Box::new(Dcs::new(n, SamplingStrategy::Stratified, 1)?),
         Err(_) => {
             let preset = common::preset(samples, "a sample count")?;
@@ -37,18 +37,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             (preset.make)(1)
         }
     };
-    dcs.prepare(setup.scene.clone(), light.clone())?;
+    let prepared_dcs = dcs.prepare(setup.scene.clone(), light.clone())?;
     let sampler = dcs.light_sampler().ok_or("no sampler")?.clone();
     let n = sampler.count();
-    let mut r = Reference::same_samples(sampler);
-    r.prepare(setup.scene.clone(), light)?;
-    let best =
-        |t: &mut dyn ShadowTechnique| -> Result<(f64, Estimate), Box<dyn std::error::Error>> {
-            let (secs, last) = common::best_of(runs.max(1), t, &view)?;
-            Ok((secs, last.ok_or("no estimate")?))
-        };
-    let (td, ed) = best(dcs.as_mut())?;
-    let (tr, er) = best(&mut r)?;
+    let r = Reference::same_samples(sampler).prepare(setup.scene.clone(), light)?;
+    let best = |t: &dyn PreparedShadows| -> Result<(f64, Estimate), Box<dyn std::error::Error>> {
+        let (secs, last) = common::best_of(runs.max(1), t, &view)?;
+        Ok((secs, last.ok_or("no estimate")?))
+    };
+    let (td, ed) = best(prepared_dcs.as_ref())?;
+    let (tr, er) = best(r.as_ref())?;
     let m = shadow_core::metrics::compare(&ed.visibility, &er.visibility)?;
     for p in &ed.stats.phases {
         print!("{} {:.4}s  ", p.name, p.seconds);

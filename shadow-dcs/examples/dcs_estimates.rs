@@ -34,8 +34,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     // `interleaved-N`: 4 x 4 interleaved sets, as the paper samples (section 5).
     let interleaved = SamplingStrategy::Interleaved { tile: 4 };
-    let mut technique: Box<dyn ShadowTechnique> = if let Some(n) = count("reference-interleaved-")?
-    {
+    let technique: Box<dyn ShadowTechnique> = if let Some(n) = count("reference-interleaved-")? {
         Box::new(Reference::same_samples(LightSampler::new(
             interleaved,
             n,
@@ -58,8 +57,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         )?
         .make)(1)
     };
-    technique.prepare(setup.scene.clone(), setup.lights[0].clone())?;
-    let (best, last) = common::best_of(runs, technique.as_mut(), &view)?;
+    let prepared = technique.prepare(setup.scene.clone(), setup.lights[0].clone())?;
+    let (best, last) = common::best_of(runs, prepared.as_ref(), &view)?;
     match last {
         Some(e) => {
             println!("{name} on {scene} {size}x{size}: best of {runs} runs {best:.4} s");

@@ -23,7 +23,7 @@
 use glam::{DVec2, DVec3, UVec2};
 use shadow_core::light::{AreaLight, LightGeometry};
 use shadow_core::sampling::{LightSampler, SamplingStrategy};
-use shadow_core::technique::TechniqueError;
+use shadow_core::technique::{TechniqueError, UnsupportedReason};
 
 use crate::coverage::{EdgeTest, RelativeSamples};
 use crate::edges::SceneEdge;
@@ -99,9 +99,8 @@ impl DiscreteTables {
         refined: bool,
         technique: &str,
     ) -> Result<Self, TechniqueError> {
-        let unsupported = |reason: &str| TechniqueError::Unsupported {
-            technique: technique.into(),
-            reason: reason.into(),
+        let unsupported = |reason: &str| {
+            TechniqueError::unsupported(technique, UnsupportedReason::Configuration(reason.into()))
         };
         let tile = match sampler.strategy() {
             SamplingStrategy::Correlated => 1,

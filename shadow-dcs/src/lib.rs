@@ -51,10 +51,10 @@
 //!
 //! let setup = shadow_core::scenes::builtin("quad-over-plane").unwrap();
 //! let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 32, 24).unwrap();
-//! let mut dcs = Dcs::new(16, SamplingStrategy::Stratified, 1).unwrap();
-//! dcs.prepare(setup.scene.clone(), setup.lights[0].clone()).unwrap();
-//! let est = dcs.estimate(&view).unwrap();
-//! assert!(est.stats.counter("wedge-pairs") > 0);
+//! let dcs = Dcs::new(16, SamplingStrategy::Stratified, 1).unwrap();
+//! let prepared = dcs.prepare(setup.scene.clone(), setup.lights[0].clone()).unwrap();
+//! let est = prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
+//! assert!(est.stats.counter("wedge-pairs").unwrap() > 0);
 //! ```
 
 #![deny(missing_docs)]

@@ -5,7 +5,7 @@
 
 use glam::{DVec3, Vec3};
 use shadow_core::light::{AreaLight, LightGeometry};
-use shadow_core::technique::TechniqueError;
+use shadow_core::technique::{TechniqueError, UnsupportedReason};
 
 /// Sides of the regular polygon circumscribing a disk light.
 const DISK_SIDES: usize = 16;
@@ -162,10 +162,15 @@ impl LightShape {
                 )
             }
             LightGeometry::Point { .. } => {
-                return Err(TechniqueError::Unsupported {
-                    technique: technique.into(),
-                    reason: "point lights have no area: there is no penumbra to sample".into(),
-                });
+                return Err(TechniqueError::unsupported(
+                    technique,
+                    UnsupportedReason::Light {
+                        kind: light.kind(),
+                        detail: Some(
+                            "point lights have no area: there is no penumbra to sample".into(),
+                        ),
+                    },
+                ));
             }
         };
         let radius = hull

@@ -107,7 +107,9 @@ struct PlanarLight {
     normal: Vec3,
 }
 
-/// Depth complexity sampling.
+/// Depth complexity sampling: a configuration ([`ShadowTechnique::prepare`] or
+/// [`Dcs::prepare_dcs`] gives the [`PreparedDcs`] that estimates).
+#[derive(Clone)]
 pub struct Dcs {
     name: String,
     sampler: LightSampler,
@@ -118,7 +120,21 @@ pub struct Dcs {
     /// Whether pixels of one shared sample set share its set-up ([`crate::shared_sets`]);
     /// off only in tests, which check the shared set-up against each pixel's own.
     share_sets: bool,
-    prepared: Option<Prepared>,
+}
+
+/// DCS prepared for one scene and light: its edges, silhouettes, wedges and tables.
+pub struct PreparedDcs {
+    config: Dcs,
+    p: Prepared,
+    stats: Stats,
+}
+
+impl std::fmt::Debug for PreparedDcs {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PreparedDcs")
+            .field("config", &self.config)
+            .finish_non_exhaustive()
+    }
 }
 
 impl std::fmt::Debug for Dcs {
@@ -310,7 +326,6 @@ impl Dcs {
             output: PerSampleOutput::Bits,
             forced_bits: None,
             share_sets: true,
-            prepared: None,
         })
     }
 
@@ -322,10 +337,25 @@ impl Dcs {
     }
 
     /// How covered samples are found (section 7.3).
-    #[must_use]
-    pub fn with_covered_samples(mut self, c: CoveredSamples) -> Self {
+    ///
+    /// # Errors
+    /// [`TechniqueError::InvalidInput`] for the tables of section 7.3 with per-pixel sample sets
+    /// (stratified or decorrelated sampling): the tables need a finite number of sets.
+    pub fn with_covered_samples(mut self, c: CoveredSamples) -> Result<Self, TechniqueError> {
+        let per_pixel = !matches!(
+            self.sampler.strategy(),
+            SamplingStrategy::Correlated | SamplingStrategy::Interleaved { .. }
+        );
+        if c != CoveredSamples::Exact && per_pixel {
+            return Err(TechniqueError::InvalidInput(format!(
+                "{}: the covered-sample tables of section 7.3 need a finite number of sample \
+                 sets (correlated or interleaved sampling), not {:?}",
+                self.name,
+                self.sampler.strategy()
+            )));
+        }
         self.covered = c;
-        self
+        Ok(self)
     }
 
     /// What per-sample visibility the estimate carries.
@@ -351,12 +381,6 @@ impl Dcs {
         self
     }
 
-    fn prepared(&self) -> Result<&Prepared, TechniqueError> {
-        self.prepared
-            .as_ref()
-            .ok_or_else(|| TechniqueError::NotPrepared(self.name.clone()))
-    }
-
     /// Everything per frame before the per-pixel pass.
     fn frame<'a>(
         &self,
@@ -364,10 +388,14 @@ impl Dcs {
         view: &'a ViewSamples,
         stats: &mut Stats,
     ) -> Result<Frame<'a>, TechniqueError> {
-        let eye = view.eye().ok_or_else(|| TechniqueError::Unsupported {
-            technique: self.name.clone(),
-            reason: "orthographic views: the shadow-volume step counts quads from an eye point"
-                .into(),
+        let eye = view.eye().ok_or_else(|| {
+            TechniqueError::unsupported(
+                &self.name,
+                UnsupportedReason::View(
+                    "orthographic views: the shadow-volume step counts quads from an eye point"
+                        .into(),
+                ),
+            )
         })?;
         let n = view.len();
         let (origins, horizon): (Vec<Vec3>, Vec<Horizon>) = (0..n)
@@ -404,8 +432,8 @@ impl Dcs {
         stats.add("shadow-volume-quads", quads);
         let max_constant = constants.par_iter().copied().max().unwrap_or(0).max(0) as u64;
         let bits = self.forced_bits.unwrap_or_else(|| width_for(max_constant));
-        stats.add("max-integration-constant", max_constant);
-        stats.add("counter-bits", bits as u64);
+        stats.gauge_max("max-integration-constant", max_constant);
+        stats.gauge_max("counter-bits", bits as u64);
         stats.add("wedges", p.scan.len() as u64);
         let planar_ok = match (&p.planar, self.covered) {
             (Some(pl), CoveredSamples::Exact) => centred
@@ -1226,9 +1254,8 @@ impl Dcs {
     /// weighted by their binary visibility (saturated opacity sums with semi-opaque occluders).
     ///
     /// # Errors
-    /// [`TechniqueError::NotPrepared`] before `prepare`; `Unsupported` for orthographic views.
-    pub fn direct_illumination(&self, view: &ViewSamples) -> Result<Vec<Vec3>, TechniqueError> {
-        let p = self.prepared()?;
+    /// `Unsupported` for orthographic views.
+    fn direct(&self, p: &Prepared, view: &ViewSamples) -> Result<Vec<Vec3>, TechniqueError> {
         let mut stats = Stats::default();
         let f = self.frame(p, view, &mut stats)?;
         let (parts, _) = self.squares(p, &f, |rect, block, buffers| {
@@ -1336,13 +1363,14 @@ impl ShadowTechnique for Dcs {
     }
 
     fn capabilities(&self) -> Capabilities {
+        // The section 7.3 tables are defined on a planar light; the exact test also takes
+        // sphere lights (their silhouette disk).
+        let mut lights = vec![LightKind::Rectangle, LightKind::Disk, LightKind::Polygon];
+        if self.covered == CoveredSamples::Exact {
+            lights.push(LightKind::Sphere);
+        }
         Capabilities {
-            lights: vec![
-                LightKind::Rectangle,
-                LightKind::Disk,
-                LightKind::Polygon,
-                LightKind::Sphere,
-            ],
+            lights,
             semi_opaque: true,
             textured_lights: true,
             needs_closed_meshes: false,
@@ -1365,14 +1393,62 @@ impl ShadowTechnique for Dcs {
         Some(&self.sampler)
     }
 
-    fn prepare(&mut self, scene: SceneRef, light: Light) -> Result<Stats, TechniqueError> {
-        self.prepared = None;
-        let caps = self.capabilities();
-        caps.check(scene.as_ref(), light.as_ref())
-            .map_err(|reason| TechniqueError::Unsupported {
-                technique: self.name.clone(),
-                reason,
-            })?;
+    fn prepare(
+        &self,
+        scene: SceneRef,
+        light: Light,
+    ) -> Result<Box<dyn PreparedShadows>, TechniqueError> {
+        Ok(Box::new(self.prepare_dcs(scene, light)?))
+    }
+}
+
+impl PreparedShadows for PreparedDcs {
+    fn name(&self) -> &str {
+        &self.config.name
+    }
+
+    fn preparation(&self) -> &Stats {
+        &self.stats
+    }
+
+    fn estimate(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError> {
+        let output = match self.config.output {
+            PerSampleOutput::None if outputs.per_sample => PerSampleOutput::Bits,
+            o => o,
+        };
+        let mut est = self.config.run(&self.p, view, output)?;
+        if outputs.direct {
+            let t0 = std::time::Instant::now();
+            est.direct = Some(self.direct_illumination(view)?);
+            est.stats.add_time("direct", t0.elapsed().as_secs_f64());
+        }
+        Ok(est)
+    }
+}
+
+impl PreparedDcs {
+    /// Direct illumination of every view sample by DCS eq. 6: the light samples' contributions
+    /// weighted by their binary visibility (saturated opacity sums with semi-opaque occluders).
+    ///
+    /// # Errors
+    /// `Unsupported` for orthographic views.
+    pub fn direct_illumination(&self, view: &ViewSamples) -> Result<Vec<Vec3>, TechniqueError> {
+        self.config.direct(&self.p, view)
+    }
+}
+
+impl Dcs {
+    /// Builds the edges, silhouettes, wedges and (section 7.3) tables for `scene` and `light`.
+    ///
+    /// # Errors
+    /// [`TechniqueError::Unsupported`] when the scene or light is outside the capabilities.
+    pub fn prepare_dcs(
+        &self,
+        scene: SceneRef,
+        light: Light,
+    ) -> Result<PreparedDcs, TechniqueError> {
+        self.capabilities()
+            .require(&self.name, scene.as_ref(), light.as_ref())?;
         let mut stats = Stats::default();
         let shape = LightShape::new(light.as_ref(), &self.name)?;
         let (edges, units) = stats.time("edges", || scene_edges(scene.as_ref(), shape.center));
@@ -1430,7 +1506,7 @@ impl ShadowTechnique for Dcs {
                 ScanWedge::new(w, pe)
             })
             .unzip();
-        self.prepared = Some(Prepared {
+        let p = Prepared {
             planar,
             rect,
             scan,
@@ -1446,12 +1522,21 @@ impl ShadowTechnique for Dcs {
             offset: RayOffset::for_extent(extent),
             extent: extent as f64,
             tables,
-        });
-        Ok(stats)
+        };
+        Ok(PreparedDcs {
+            config: self.clone(),
+            p,
+            stats,
+        })
     }
 
-    fn estimate(&mut self, view: &ViewSamples) -> Result<Estimate, TechniqueError> {
-        let p = self.prepared()?;
+    /// The estimate of `view` on prepared data `p`, with `output` per sample.
+    fn run(
+        &self,
+        p: &Prepared,
+        view: &ViewSamples,
+        output: PerSampleOutput,
+    ) -> Result<Estimate, TechniqueError> {
         let mut stats = Stats::default();
         let f = self.frame(p, view, &mut stats)?;
         let n = self.sampler.count() as usize;
@@ -1466,7 +1551,6 @@ impl ShadowTechnique for Dcs {
             depth: Vec<u32>,
             counts: Counts,
         }
-        let output = self.output;
         let (strips, block_wedges) = stats.time("depth-complexity", || {
             self.squares(p, &f, |rect, block, buffers| {
                 let m = rect.len();
@@ -1642,10 +1726,7 @@ impl ShadowTechnique for Dcs {
         stats.add("pixels-shared-sample-sets", counts.shared_set_pixels);
         stats.add("shared-sample-sets-built", counts.shared_sets_built);
         vis.validate()?;
-        Ok(Estimate {
-            visibility: vis,
-            stats,
-        })
+        Ok(Estimate::new(vis, stats))
     }
 }
 
@@ -1717,21 +1798,31 @@ mod tests {
                     let mut d = Dcs::new(64, strategy, 7)
                         .unwrap()
                         .with_covered_samples(covered)
+                        .unwrap()
                         .with_per_sample(PerSampleOutput::Counters);
                     d.share_sets = share;
-                    d.prepare(setup.scene.clone(), setup.lights[0].clone())
+                    let d_prepared = d
+                        .prepare(setup.scene.clone(), setup.lights[0].clone())
                         .unwrap();
-                    d.estimate(&view).unwrap()
+                    d_prepared.estimate(&view, Outputs::VISIBILITY).unwrap()
                 };
                 let (shared, own) = (run(true), run(false));
                 let case = format!("{name} {strategy:?} {covered:?}");
                 assert_eq!(depth(&shared), depth(&own), "{case}");
                 let (pixels, built) = (
-                    shared.stats.counter("pixels-shared-sample-sets"),
-                    shared.stats.counter("shared-sample-sets-built"),
+                    shared.stats.counter("pixels-shared-sample-sets").unwrap(),
+                    shared.stats.counter("shared-sample-sets-built").unwrap(),
                 );
-                assert_eq!(own.stats.counter("pixels-shared-sample-sets"), 0, "{case}");
-                assert_eq!(pixels, shared.stats.counter("pixels-per-sample"), "{case}");
+                assert_eq!(
+                    own.stats.counter("pixels-shared-sample-sets").unwrap(),
+                    0,
+                    "{case}"
+                );
+                assert_eq!(
+                    pixels,
+                    shared.stats.counter("pixels-per-sample").unwrap(),
+                    "{case}"
+                );
                 let sets = match strategy {
                     SamplingStrategy::Interleaved { tile } => u64::from(tile * tile),
                     _ => 1,

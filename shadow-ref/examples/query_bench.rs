@@ -22,15 +22,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let h: u32 = args.get(2).map_or(Ok(120), |s| s.parse())?;
     let setup = shadow_core::scenes::builtin(scene)?;
     let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), w, h)?;
-    let mut r = Reference::stratified(64, 1)?;
-    r.prepare(setup.scene.clone(), setup.lights[0].clone())?;
-    let segs = r.segments(&view)?;
+    let r = Reference::stratified(64, 1)?;
+    let r_prepared = r.prepare_reference(setup.scene.clone(), setup.lights[0].clone())?;
+    let segs = r_prepared.segments(&view);
     // The reference's whole trace phase (sampling, offsets, beam culling, queries) answering
     // the same segments, on one thread.
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     let mut trace = f64::INFINITY;
     for _ in 0..8 {
-        let est = pool.install(|| r.estimate(&view))?;
+        let est = pool.install(|| r_prepared.estimate(&view, Outputs::VISIBILITY))?;
         let secs = est
             .stats
             .phases
@@ -39,7 +39,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .map_or(f64::INFINITY, |p| p.seconds);
         trace = trace.min(secs);
     }
-    let bvh = r.bvh().ok_or("not prepared")?;
+    let bvh = r_prepared.bvh();
     let time = |f: &dyn Fn(&Segment) -> bool| {
         let mut best = f64::INFINITY;
         let mut blocked = 0;

@@ -21,10 +21,10 @@
 //!
 //! let setup = shadow_core::scenes::builtin("quad-over-plane").unwrap();
 //! let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 24, 18).unwrap();
-//! let mut r = Reference::stratified(64, 1).unwrap();
-//! r.prepare(setup.scene.clone(), setup.lights[0].clone()).unwrap();
-//! let est = r.estimate(&view).unwrap();
-//! assert!(est.stats.counter("occlusion-rays") > 0);
+//! let r = Reference::stratified(64, 1).unwrap();
+//! let prepared = r.prepare(setup.scene.clone(), setup.lights[0].clone()).unwrap();
+//! let est = prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
+//! assert!(est.stats.counter("occlusion-rays").unwrap() > 0);
 //! ```
 
 #![deny(missing_docs)]
@@ -38,4 +38,4 @@ pub mod watertight;
 pub mod wide;
 
 pub use presets::presets;
-pub use reference::Reference;
+pub use reference::{PreparedReference, Reference};

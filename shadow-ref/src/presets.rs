@@ -12,14 +12,18 @@ use shadow_core::prelude::*;
 
 use crate::Reference;
 
-fn stratified(samples: u32, seed: u64) -> Box<dyn ShadowTechnique> {
-    let r = Reference::stratified(samples, seed).expect("preset sample counts are valid");
+/// The stratified reference at `samples` samples, named `ref` at 1024 and `ref-N` otherwise.
+///
+/// # Errors
+/// [`TechniqueError::InvalidInput`] for a count outside the sampler's range.
+fn stratified(samples: u32, seed: u64) -> Result<Box<dyn ShadowTechnique>, TechniqueError> {
+    let r = Reference::stratified(samples, seed)?;
     let name = if samples == 1024 {
         "ref".to_string()
     } else {
         format!("ref-{samples}")
     };
-    Box::new(r.named(&name))
+    Ok(Box::new(r.named(&name)))
 }
 
 /// Measured errors: scene, [rmse, penumbra rmse, bias, max, share > 0.1].
@@ -100,23 +104,26 @@ pub fn presets() -> Vec<Preset> {
         Preset {
             name: "ref",
             description: "ray-traced reference, 1024 stratified samples per pixel",
-            make: |seed| stratified(1024, seed),
+            make: |seed| stratified(1024, seed).expect("the preset\'s sample count is valid"),
             budget: |scene| Budget::lookup(REF_1024, scene),
             with_samples: Some(stratified),
+            known_limitations: &[],
         },
         Preset {
             name: "ref-16",
             description: "ray-traced reference, 16 stratified samples per pixel",
-            make: |seed| stratified(16, seed),
+            make: |seed| stratified(16, seed).expect("the preset\'s sample count is valid"),
             budget: |scene| Budget::lookup(REF_16, scene),
             with_samples: Some(stratified),
+            known_limitations: &[],
         },
         Preset {
             name: "ref-64",
             description: "ray-traced reference, 64 stratified samples per pixel",
-            make: |seed| stratified(64, seed),
+            make: |seed| stratified(64, seed).expect("the preset\'s sample count is valid"),
             budget: |scene| Budget::lookup(REF_64, scene),
             with_samples: Some(stratified),
+            known_limitations: &[],
         },
         Preset {
             name: "ref-hard",
@@ -124,6 +131,7 @@ pub fn presets() -> Vec<Preset> {
             make: |_| Box::new(Reference::hard()),
             budget: |scene| Budget::lookup(REF_HARD, scene),
             with_samples: None,
+            known_limitations: &[],
         },
     ]
 }

@@ -47,6 +47,13 @@ pub enum SampleSource {
     Hard,
 }
 
+/// The phase of an estimate that traces the occlusion segments (for ray-rate figures).
+pub const TRACE_PHASE: &str = "trace";
+/// The counter of occlusion segments an estimate traced.
+pub const RAYS_COUNTER: &str = "occlusion-rays";
+/// The gauge of threads the trace ran on.
+pub const THREADS_GAUGE: &str = "threads";
+
 /// Receivers with fewer samples than this skip the beam (a single ray is cheaper).
 const BEAM_MIN_SAMPLES: usize = 4;
 /// Largest candidate list tested segment by segment; beyond it the BVH answers each segment.
@@ -89,6 +96,7 @@ impl Counts {
     }
 }
 
+/// What [`Reference`] builds per scene and light.
 struct Prepared {
     quad: Option<[Vec3; 4]>,
     beam_eps: f32,
@@ -99,14 +107,30 @@ struct Prepared {
     offset: RayOffset,
 }
 
-/// The ray-traced reference.
+/// The ray-traced reference: a configuration ([`ShadowTechnique::prepare`] or
+/// [`Reference::prepare_reference`] gives the [`PreparedReference`] that estimates).
+#[derive(Clone)]
 pub struct Reference {
     name: String,
     source: SampleSource,
     sampler: LightSampler,
     per_sample: bool,
     beam: bool,
-    prepared: Option<Prepared>,
+}
+
+/// The reference prepared for one scene and light: its BVH, ray offsets and light.
+pub struct PreparedReference {
+    config: Reference,
+    p: Prepared,
+    stats: Stats,
+}
+
+impl std::fmt::Debug for PreparedReference {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PreparedReference")
+            .field("config", &self.config)
+            .finish_non_exhaustive()
+    }
 }
 
 impl std::fmt::Debug for Reference {
@@ -138,7 +162,6 @@ impl Reference {
             sampler: LightSampler::new(SamplingStrategy::Stratified, samples, seed)?,
             per_sample: false,
             beam: true,
-            prepared: None,
         })
     }
 
@@ -150,7 +173,6 @@ impl Reference {
             sampler,
             per_sample: true,
             beam: true,
-            prepared: None,
         }
     }
 
@@ -163,7 +185,6 @@ impl Reference {
                 .expect("one sample is valid"),
             per_sample: true,
             beam: true,
-            prepared: None,
         }
     }
 
@@ -189,15 +210,48 @@ impl Reference {
         self
     }
 
-    /// The BVH, once prepared.
-    pub fn bvh(&self) -> Option<&OcclusionBvh> {
-        self.prepared.as_ref().map(|p| &p.bvh)
-    }
-
-    fn prepared(&self) -> Result<&Prepared, TechniqueError> {
-        self.prepared
-            .as_ref()
-            .ok_or_else(|| TechniqueError::NotPrepared(self.name.clone()))
+    /// Builds the BVH and everything else per scene and light.
+    ///
+    /// # Errors
+    /// [`TechniqueError::InvalidInput`] for a zero-area light whose point light is invalid.
+    pub fn prepare_reference(
+        &self,
+        scene: SceneRef,
+        light: Light,
+    ) -> Result<PreparedReference, TechniqueError> {
+        let mut stats = Stats::default();
+        let bvh = stats.time("bvh-build", || OcclusionBvh::build(scene.as_ref()));
+        stats.add("triangles", scene.triangle_count() as u64);
+        let extent = scene.bounds().union(light.bounds()).diagonal();
+        let light: Light = if light.area() == 0.0 {
+            Arc::new(
+                PointLight::new(light.center(), light.radiance().clone())
+                    .map_err(|e| TechniqueError::InvalidInput(e.to_string()))?,
+            )
+        } else {
+            light
+        };
+        let bounds = scene.bounds().union(light.bounds());
+        let coord = bounds.min.abs().max(bounds.max.abs()).max_element();
+        let quad = if self.source == SampleSource::Hard {
+            None
+        } else {
+            light.geometry().bounding_quad()
+        };
+        let p = Prepared {
+            quad,
+            beam_eps: 1e-5 * extent.max(f32::MIN_POSITIVE) + 8.0 * f32::EPSILON * coord,
+            semi_opaque: scene.has_semi_opaque(),
+            scene,
+            light,
+            bvh,
+            offset: RayOffset::for_extent(extent),
+        };
+        Ok(PreparedReference {
+            config: self.clone(),
+            p,
+            stats,
+        })
     }
 
     /// The light samples of a pixel (the centre alone in hard mode).
@@ -221,45 +275,6 @@ impl Reference {
         }
         self.sampler.unit_samples(pixel, units);
         light.sample_into(units, out);
-    }
-
-    /// The occlusion segment from view sample `s` to light point `y`: robust origin, unit
-    /// direction and length, or `None` when `y` is below the receiver's tangent plane.
-    ///
-    /// # Errors
-    /// [`TechniqueError::NotPrepared`] before `prepare`.
-    pub fn segment(
-        &self,
-        s: &ViewSample,
-        y: Vec3,
-    ) -> Result<Option<(Vec3, Vec3, f32)>, TechniqueError> {
-        Ok(segment(self.prepared()?, s, y))
-    }
-
-    /// Every occlusion segment the reference casts for `view`, in pixel and sample order:
-    /// (origin, unit direction, length, receiver triangle). For benchmarks and peer
-    /// comparisons on identical rays.
-    ///
-    /// # Errors
-    /// [`TechniqueError::NotPrepared`] before `prepare`.
-    pub fn segments(
-        &self,
-        view: &ViewSamples,
-    ) -> Result<Vec<(Vec3, Vec3, f32, u32)>, TechniqueError> {
-        let p = self.prepared()?;
-        let (mut units, mut samples) = (Vec::new(), Vec::new());
-        let mut out = Vec::new();
-        for i in 0..view.len() {
-            let Some(s) = view.get(i) else { continue };
-            self.pixel_samples(p.light.as_ref(), s.pixel, &mut units, &mut samples);
-            let origin = p.offset.offset(s.position, s.geometric_normal);
-            for y in &samples {
-                if let Some((o, d, t)) = segment_from(origin, &s, y.position) {
-                    out.push((o, d, t, s.triangle));
-                }
-            }
-        }
-        Ok(out)
     }
 
     /// The beam of one receiver (when the light is planar and there are enough samples to
@@ -359,37 +374,6 @@ impl Reference {
         }
         counts
     }
-
-    /// Direct illumination of every view sample (DCS eq. 6 with the exact transmittance).
-    ///
-    /// # Errors
-    /// [`TechniqueError::NotPrepared`] before `prepare`.
-    pub fn direct_illumination(&self, view: &ViewSamples) -> Result<DirectImage, TechniqueError> {
-        let p = self.prepared()?;
-        let w = view.width() as usize;
-        let mut out = vec![Vec3::ZERO; view.len()];
-        out.par_chunks_mut(w).enumerate().for_each(|(row, line)| {
-            let (mut units, mut samples, mut scratch) =
-                (Vec::new(), Vec::new(), Scratch::default());
-            for (x, px) in line.iter_mut().enumerate() {
-                let Some(s) = view.get_at(x as u32, row as u32) else {
-                    continue;
-                };
-                self.pixel_samples(p.light.as_ref(), s.pixel, &mut units, &mut samples);
-                let rb = self.receiver_beam(p, &s, samples.len(), &mut scratch);
-                self.sample_visibility(p, &s, &rb, &samples, &mut scratch);
-                let vis = &scratch.vis;
-                let albedo = p.scene.albedo(s.triangle as usize);
-                let light: &dyn AreaLight = if self.source == SampleSource::Hard {
-                    &HardLight(p.light.center())
-                } else {
-                    p.light.as_ref()
-                };
-                *px = pixel_direct(&s, albedo, light, &samples, |k| vis[k]);
-            }
-        });
-        Ok(out)
-    }
 }
 
 fn segment(p: &Prepared, s: &ViewSample, y: Vec3) -> Option<(Vec3, Vec3, f32)> {
@@ -469,40 +453,106 @@ impl ShadowTechnique for Reference {
         (self.source != SampleSource::Hard).then_some(&self.sampler)
     }
 
-    fn prepare(&mut self, scene: SceneRef, light: Light) -> Result<Stats, TechniqueError> {
-        let mut stats = Stats::default();
-        let bvh = stats.time("bvh-build", || OcclusionBvh::build(scene.as_ref()));
-        stats.add("triangles", scene.triangle_count() as u64);
-        let extent = scene.bounds().union(light.bounds()).diagonal();
-        let light: Light = if light.area() == 0.0 {
-            Arc::new(
-                PointLight::new(light.center(), light.radiance().clone())
-                    .map_err(|e| TechniqueError::InvalidInput(e.to_string()))?,
-            )
-        } else {
-            light
-        };
-        let bounds = scene.bounds().union(light.bounds());
-        let coord = bounds.min.abs().max(bounds.max.abs()).max_element();
-        let quad = if self.source == SampleSource::Hard {
-            None
-        } else {
-            light.geometry().bounding_quad()
-        };
-        self.prepared = Some(Prepared {
-            quad,
-            beam_eps: 1e-5 * extent.max(f32::MIN_POSITIVE) + 8.0 * f32::EPSILON * coord,
-            semi_opaque: scene.has_semi_opaque(),
-            scene,
-            light,
-            bvh,
-            offset: RayOffset::for_extent(extent),
-        });
-        Ok(stats)
+    fn prepare(
+        &self,
+        scene: SceneRef,
+        light: Light,
+    ) -> Result<Box<dyn PreparedShadows>, TechniqueError> {
+        Ok(Box::new(self.prepare_reference(scene, light)?))
+    }
+}
+
+impl PreparedShadows for PreparedReference {
+    fn name(&self) -> &str {
+        &self.config.name
     }
 
-    fn estimate(&mut self, view: &ViewSamples) -> Result<Estimate, TechniqueError> {
-        let p = self.prepared()?;
+    fn preparation(&self) -> &Stats {
+        &self.stats
+    }
+
+    fn estimate(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError> {
+        let per_sample = self.config.per_sample || outputs.per_sample;
+        let mut est = self.config.run(&self.p, view, per_sample)?;
+        if outputs.direct {
+            est.direct = Some(est.stats.time("direct", || self.direct_illumination(view)));
+        }
+        Ok(est)
+    }
+}
+
+impl PreparedReference {
+    /// The BVH.
+    pub fn bvh(&self) -> &OcclusionBvh {
+        &self.p.bvh
+    }
+
+    /// The occlusion segment from view sample `s` to light point `y`: robust origin, unit
+    /// direction and length, or `None` when `y` is below the receiver's tangent plane.
+    ///
+    pub fn segment(&self, s: &ViewSample, y: Vec3) -> Option<(Vec3, Vec3, f32)> {
+        segment(&self.p, s, y)
+    }
+
+    /// Every occlusion segment the reference casts for `view`, in pixel and sample order:
+    /// (origin, unit direction, length, receiver triangle). For benchmarks and peer
+    /// comparisons on identical rays.
+    pub fn segments(&self, view: &ViewSamples) -> Vec<(Vec3, Vec3, f32, u32)> {
+        let p = &self.p;
+        let (mut units, mut samples) = (Vec::new(), Vec::new());
+        let mut out = Vec::new();
+        for i in 0..view.len() {
+            let Some(s) = view.get(i) else { continue };
+            self.config
+                .pixel_samples(p.light.as_ref(), s.pixel, &mut units, &mut samples);
+            let origin = p.offset.offset(s.position, s.geometric_normal);
+            for y in &samples {
+                if let Some((o, d, t)) = segment_from(origin, &s, y.position) {
+                    out.push((o, d, t, s.triangle));
+                }
+            }
+        }
+        out
+    }
+
+    /// Direct illumination of every view sample (DCS eq. 6 with the exact transmittance).
+    ///
+    pub fn direct_illumination(&self, view: &ViewSamples) -> DirectImage {
+        let (c, p) = (&self.config, &self.p);
+        let w = view.width() as usize;
+        let mut out = vec![Vec3::ZERO; view.len()];
+        out.par_chunks_mut(w).enumerate().for_each(|(row, line)| {
+            let (mut units, mut samples, mut scratch) =
+                (Vec::new(), Vec::new(), Scratch::default());
+            for (x, px) in line.iter_mut().enumerate() {
+                let Some(s) = view.get_at(x as u32, row as u32) else {
+                    continue;
+                };
+                c.pixel_samples(p.light.as_ref(), s.pixel, &mut units, &mut samples);
+                let rb = c.receiver_beam(p, &s, samples.len(), &mut scratch);
+                c.sample_visibility(p, &s, &rb, &samples, &mut scratch);
+                let vis = &scratch.vis;
+                let albedo = p.scene.albedo(s.triangle as usize);
+                let light: &dyn AreaLight = if c.source == SampleSource::Hard {
+                    &HardLight(p.light.center())
+                } else {
+                    p.light.as_ref()
+                };
+                *px = pixel_direct(&s, albedo, light, &samples, |k| vis[k]);
+            }
+        });
+        out
+    }
+}
+
+impl Reference {
+    /// The estimate of `view` on prepared data `p`, with per-sample bits when `per_sample`.
+    fn run(
+        &self,
+        p: &Prepared,
+        view: &ViewSamples,
+        per_sample: bool,
+    ) -> Result<Estimate, TechniqueError> {
         let mut stats = Stats::default();
         let textured = p.light.is_textured();
         let n = if self.source == SampleSource::Hard {
@@ -521,7 +571,7 @@ impl ShadowTechnique for Reference {
             below: u64,
             counts: Counts,
         }
-        let rows: Vec<Row> = stats.time("trace", || {
+        let rows: Vec<Row> = stats.time(TRACE_PHASE, || {
             (0..view.height() as usize)
                 .into_par_iter()
                 .map(|row| {
@@ -529,7 +579,7 @@ impl ShadowTechnique for Reference {
                         v: vec![0.0; w],
                         rgb: vec![Vec3::ZERO; if textured { w } else { 0 }],
                         class: vec![PixelClass::Background; w],
-                        bits: vec![0; if self.per_sample { w * words } else { 0 }],
+                        bits: vec![0; if per_sample { w * words } else { 0 }],
                         rays: 0,
                         below: 0,
                         counts: Counts::default(),
@@ -576,7 +626,7 @@ impl ShadowTechnique for Reference {
                         } else {
                             PixelClass::Penumbra
                         };
-                        if self.per_sample {
+                        if per_sample {
                             for (k, &v) in vis.iter().enumerate() {
                                 if v == 1.0 {
                                     r.bits[x * words + k / 64] |= 1 << (k % 64);
@@ -594,11 +644,7 @@ impl ShadowTechnique for Reference {
             VisibilityImage::scalar(view)
         };
         let mut classes = Vec::with_capacity(view.len());
-        let mut bits = Vec::with_capacity(if self.per_sample {
-            view.len() * words
-        } else {
-            0
-        });
+        let mut bits = Vec::with_capacity(if per_sample { view.len() * words } else { 0 });
         for (row, r) in rows.iter().enumerate() {
             if textured {
                 vis.rgbs_mut()[row * w..(row + 1) * w].copy_from_slice(&r.rgb);
@@ -607,7 +653,7 @@ impl ShadowTechnique for Reference {
             }
             classes.extend_from_slice(&r.class);
             bits.extend_from_slice(&r.bits);
-            stats.add("occlusion-rays", r.rays);
+            stats.add(RAYS_COUNTER, r.rays);
             stats.add("samples-below-horizon", r.below);
             stats.add("rays-single", r.counts.traversed);
             stats.add("pixels-beam-clear", r.counts.beam_clear);
@@ -616,18 +662,15 @@ impl ShadowTechnique for Reference {
             stats.add("pixels-lit-without-samples", r.counts.unsampled);
         }
         stats.add("pixels", view.valid_count() as u64);
-        stats.add("threads", rayon::current_num_threads() as u64);
+        stats.gauge_max(THREADS_GAUGE, rayon::current_num_threads() as u64);
         vis.set_classes(classes)?;
-        if self.per_sample {
+        if per_sample {
             vis.set_per_sample(PerSampleVisibility::Bits {
                 samples: n,
                 words: bits,
             })?;
         }
         vis.validate()?;
-        Ok(Estimate {
-            visibility: vis,
-            stats,
-        })
+        Ok(Estimate::new(vis, stats))
     }
 }

@@ -10,10 +10,14 @@ use shadow_core::scenes::{BUILTIN_SCENES, builtin, quad_over_plane as q};
 use shadow_ref::Reference;
 use shadow_ref::watertight::ShearedRay;
 
-fn run(r: &mut Reference, setup: &SceneSetup, view: &ViewSamples) -> VisibilityImage {
-    r.prepare(setup.scene.clone(), setup.lights[0].clone())
+fn run(r: &Reference, setup: &SceneSetup, view: &ViewSamples) -> VisibilityImage {
+    let r_prepared = r
+        .prepare_reference(setup.scene.clone(), setup.lights[0].clone())
         .unwrap();
-    r.estimate(view).unwrap().visibility
+    r_prepared
+        .estimate(view, Outputs::VISIBILITY)
+        .unwrap()
+        .visibility
 }
 
 /// Area of the intersection of the interval `[a0, a1]` with `[b0, b1]`.
@@ -55,7 +59,7 @@ fn floor_errors(setup: &SceneSetup, view: &ViewSamples, v: &VisibilityImage) -> 
 fn square_occluder_closed_form() {
     let setup = builtin("quad-over-plane").unwrap();
     let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera.unwrap(), 64, 48).unwrap();
-    let v = run(&mut Reference::stratified(1024, 3).unwrap(), &setup, &view);
+    let v = run(&Reference::stratified(1024, 3).unwrap(), &setup, &view);
     let (rmse, max, n) = floor_errors(&setup, &view, &v);
     assert!(n > 1000);
     assert!(rmse < 4e-3, "rmse {rmse}");
@@ -73,7 +77,7 @@ fn error_falls_at_the_stratified_rate() {
             floor_errors(
                 &setup,
                 &view,
-                &run(&mut Reference::stratified(n, 11).unwrap(), &setup, &view),
+                &run(&Reference::stratified(n, 11).unwrap(), &setup, &view),
             )
             .0
         })
@@ -153,7 +157,7 @@ fn single_triangle_occluder_closed_form() {
     };
     let cam = Camera::look_at(Vec3::new(0.0, 3.0, 3.0), Vec3::ZERO, Vec3::Y, 0.9).unwrap();
     let view = ViewSamples::render(setup.scene.as_ref(), &cam, 64, 48).unwrap();
-    let v = run(&mut Reference::stratified(1024, 5).unwrap(), &setup, &view);
+    let v = run(&Reference::stratified(1024, 5).unwrap(), &setup, &view);
     let (mut sq, mut n, mut max) = (0.0, 0, 0.0f64);
     for i in 0..view.len() {
         let Some(s) = view.get(i) else { continue };
@@ -219,10 +223,11 @@ fn unoccluded_direct_illumination_equals_the_form_factor() {
     };
     let cam = Camera::look_at(Vec3::new(0.0, 3.0, 3.0), Vec3::ZERO, Vec3::Y, 0.9).unwrap();
     let view = ViewSamples::render(setup.scene.as_ref(), &cam, 48, 36).unwrap();
-    let mut r = Reference::stratified(1024, 2).unwrap();
-    r.prepare(setup.scene.clone(), setup.lights[0].clone())
+    let r = Reference::stratified(1024, 2).unwrap();
+    let r_prepared = r
+        .prepare_reference(setup.scene.clone(), setup.lights[0].clone())
         .unwrap();
-    let direct = r.direct_illumination(&view).unwrap();
+    let direct = r_prepared.direct_illumination(&view);
     let mut worst = 0.0f64;
     for i in 0..view.len() {
         let Some(s) = view.get(i) else { continue };
@@ -243,10 +248,14 @@ fn bvh_equals_brute_force_on_builtin_scenes() {
         let view =
             ViewSamples::render(setup.scene.as_ref(), &setup.camera.unwrap(), 12, 9).unwrap();
         let sampler = LightSampler::new(SamplingStrategy::Stratified, 16, 4).unwrap();
-        let mut r = Reference::same_samples(sampler.clone());
-        r.prepare(setup.scene.clone(), setup.lights[0].clone())
+        let r = Reference::same_samples(sampler.clone());
+        let r_prepared = r
+            .prepare_reference(setup.scene.clone(), setup.lights[0].clone())
             .unwrap();
-        let est = r.estimate(&view).unwrap().visibility;
+        let est = r_prepared
+            .estimate(&view, Outputs::VISIBILITY)
+            .unwrap()
+            .visibility;
         let ps = est.per_sample().unwrap();
         let scene = setup.scene.as_ref();
         let tris: Vec<[glam::Vec3A; 3]> = (0..scene.triangle_count())
@@ -259,7 +268,7 @@ fn bvh_equals_brute_force_on_builtin_scenes() {
             sampler.unit_samples(s.pixel, &mut units);
             for (k, u) in units.iter().enumerate() {
                 let y = setup.lights[0].sample(*u).position;
-                let free = match r.segment(&s, y).unwrap() {
+                let free = match r_prepared.segment(&s, y) {
                     None => false,
                     Some((o, d, t)) => {
                         let ray = ShearedRay::new(o.into(), d.into());
@@ -337,9 +346,14 @@ fn no_acne_on_flat_and_curved_receivers() {
         .unwrap();
         let view = ViewSamples::render(setup.scene.as_ref(), &cam, 48, 36).unwrap();
         let sampler = LightSampler::new(SamplingStrategy::Stratified, 16, 1).unwrap();
-        let mut r = Reference::same_samples(sampler.clone());
-        r.prepare(setup.scene.clone(), light.clone()).unwrap();
-        let est = r.estimate(&view).unwrap().visibility;
+        let r = Reference::same_samples(sampler.clone());
+        let r_prepared = r
+            .prepare_reference(setup.scene.clone(), light.clone())
+            .unwrap();
+        let est = r_prepared
+            .estimate(&view, Outputs::VISIBILITY)
+            .unwrap()
+            .visibility;
         let ps = est.per_sample().unwrap();
         let mut units = Vec::new();
         let mut tested = 0;
@@ -371,9 +385,9 @@ fn no_leak_through_shared_edges_and_vertices() {
     let light: Light = Arc::new(
         PointLight::new(Vec3::new(0.1, 3.0, -0.2), Radiance::Constant(Vec3::ONE)).unwrap(),
     );
-    let mut r = Reference::hard();
-    r.prepare(scene.clone(), light).unwrap();
-    let bvh = r.bvh().unwrap();
+    let r = Reference::hard();
+    let r_prepared = r.prepare_reference(scene.clone(), light).unwrap();
+    let bvh = r_prepared.bvh();
     let centre = Vec3::new(0.1, 1.0, -0.2);
     let mut targets: Vec<Vec3> = p.clone();
     for tri in &t {
@@ -403,12 +417,12 @@ fn output_is_identical_whatever_the_thread_count() {
         .num_threads(1)
         .build()
         .unwrap();
-    let a = one.install(|| run(&mut Reference::stratified(64, 9).unwrap(), &setup, &view));
+    let a = one.install(|| run(&Reference::stratified(64, 9).unwrap(), &setup, &view));
     let three = rayon::ThreadPoolBuilder::new()
         .num_threads(3)
         .build()
         .unwrap();
-    let b = three.install(|| run(&mut Reference::stratified(64, 9).unwrap(), &setup, &view));
+    let b = three.install(|| run(&Reference::stratified(64, 9).unwrap(), &setup, &view));
     assert_eq!(a.coefficients(), b.coefficients());
 }
 
@@ -416,7 +430,7 @@ fn output_is_identical_whatever_the_thread_count() {
 fn point_light_gives_the_hard_shadow_and_textured_lights_give_rgb() {
     let setup = builtin("quad-over-plane").unwrap();
     let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera.unwrap(), 40, 30).unwrap();
-    let v = run(&mut Reference::hard(), &setup, &view);
+    let v = run(&Reference::hard(), &setup, &view);
     for i in 0..view.len() {
         let Some(s) = view.get(i) else { continue };
         if s.position.y.abs() > 1e-6 {
@@ -436,7 +450,7 @@ fn point_light_gives_the_hard_shadow_and_textured_lights_give_rgb() {
     }
     let tex = builtin("textured-light").unwrap();
     let view = ViewSamples::render(tex.scene.as_ref(), &tex.camera.unwrap(), 24, 18).unwrap();
-    let v = run(&mut Reference::stratified(64, 1).unwrap(), &tex, &view);
+    let v = run(&Reference::stratified(64, 1).unwrap(), &tex, &view);
     assert!(v.is_rgb());
     // A fully lit pixel sees the mean radiance of the texture.
     let mean = tex.lights[0].radiance().mean();
@@ -496,7 +510,7 @@ fn semi_opaque_occluders_multiply_transmittances() {
     )
     .unwrap();
     let view = ViewSamples::render(setup.scene.as_ref(), &cam, 8, 8).unwrap();
-    let v = run(&mut Reference::stratified(16, 1).unwrap(), &setup, &view);
+    let v = run(&Reference::stratified(16, 1).unwrap(), &setup, &view);
     let centre = view.get((4 * 8 + 4) as usize).unwrap();
     assert!(centre.position.y.abs() < 1e-6);
     assert!(
@@ -516,9 +530,9 @@ fn beam_culling_changes_nothing_but_time() {
         let view =
             ViewSamples::render(setup.scene.as_ref(), &setup.camera.unwrap(), 32, 24).unwrap();
         let sampler = LightSampler::new(SamplingStrategy::Stratified, 64, 8).unwrap();
-        let with = run(&mut Reference::same_samples(sampler.clone()), &setup, &view);
-        let mut plain = Reference::same_samples(sampler).with_beam(false);
-        let without = run(&mut plain, &setup, &view);
+        let with = run(&Reference::same_samples(sampler.clone()), &setup, &view);
+        let plain = Reference::same_samples(sampler).with_beam(false);
+        let without = run(&plain, &setup, &view);
         assert_eq!(with.coefficients(), without.coefficients(), "{name}");
         assert_eq!(with.per_sample(), without.per_sample(), "{name}");
     }
@@ -533,11 +547,12 @@ fn wide_tree_equals_the_cwbvh() {
         let setup = builtin(name).unwrap();
         let view =
             ViewSamples::render(setup.scene.as_ref(), &setup.camera.unwrap(), 32, 24).unwrap();
-        let mut r = Reference::stratified(16, 3).unwrap();
-        r.prepare(setup.scene.clone(), setup.lights[0].clone())
+        let r = Reference::stratified(16, 3).unwrap();
+        let r_prepared = r
+            .prepare_reference(setup.scene.clone(), setup.lights[0].clone())
             .unwrap();
-        let bvh = r.bvh().unwrap();
-        let mut segs = r.segments(&view).unwrap();
+        let bvh = r_prepared.bvh();
+        let mut segs = r_prepared.segments(&view);
         let b = setup.scene.bounds();
         let (lo, hi) = (b.min, b.max);
         let size = hi - lo;
@@ -575,11 +590,113 @@ fn beams_prove_lit_receivers_clear() {
     // floor's triangles together with the occluder's (each triangle's own box is tested).
     let setup = builtin("quad-over-plane").unwrap();
     let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera.unwrap(), 32, 24).unwrap();
-    let mut r = Reference::stratified(64, 1).unwrap();
-    r.prepare(setup.scene.clone(), setup.lights[0].clone())
+    let r = Reference::stratified(64, 1).unwrap();
+    let r_prepared = r
+        .prepare_reference(setup.scene.clone(), setup.lights[0].clone())
         .unwrap();
-    let est = r.estimate(&view).unwrap();
-    let clear = est.stats.counter("pixels-beam-clear");
-    let pixels = est.stats.counter("pixels");
+    let est = r_prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
+    let clear = est.stats.counter("pixels-beam-clear").unwrap();
+    let pixels = est.stats.counter("pixels").unwrap();
     assert!(2 * clear > pixels, "{clear} clear beams of {pixels} pixels");
+}
+
+/// The direct light every sample-based technique gets for `Outputs::direct`
+/// (`direct_from_per_sample`, from binary per-sample visibility) equals the reference's own
+/// eq. 6 on an opaque scene, where the reference's transmittances are binary too.
+#[test]
+fn direct_light_from_per_sample_bits_equals_the_references_own() {
+    for name in ["bunny", "sphere-light", "textured-light"] {
+        let setup = builtin(name).unwrap();
+        let view =
+            ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 40, 30).unwrap();
+        let sampler = LightSampler::new(SamplingStrategy::Stratified, 32, 9).unwrap();
+        let r = Reference::same_samples(sampler.clone())
+            .prepare_reference(setup.scene.clone(), setup.lights[0].clone())
+            .unwrap();
+        let est = r
+            .estimate(
+                &view,
+                Outputs {
+                    per_sample: true,
+                    direct: true,
+                },
+            )
+            .unwrap();
+        let own = est.direct.clone().unwrap();
+        let from_bits = shadow_core::technique::direct_from_per_sample(
+            setup.scene.as_ref(),
+            setup.lights[0].as_ref(),
+            &sampler,
+            &view,
+            &est.visibility,
+        )
+        .unwrap();
+        let mut lit = 0;
+        for (a, b) in own.iter().zip(&from_bits) {
+            assert!(
+                (*a - *b).abs().max_element() <= 1e-6 * (1.0 + a.max_element()),
+                "{name}"
+            );
+            lit += (a.max_element() > 0.0) as u32;
+        }
+        assert!(lit > 100, "{name}: {lit} lit pixels");
+        // Without per-sample data there is nothing to shade from: an error, not zeros.
+        let plain = Reference::stratified(32, 9)
+            .unwrap()
+            .prepare_reference(setup.scene.clone(), setup.lights[0].clone())
+            .unwrap()
+            .estimate(&view, Outputs::VISIBILITY)
+            .unwrap();
+        assert!(plain.visibility.per_sample().is_none());
+        assert!(
+            shadow_core::technique::direct_from_per_sample(
+                setup.scene.as_ref(),
+                setup.lights[0].as_ref(),
+                &sampler,
+                &view,
+                &plain.visibility,
+            )
+            .is_err()
+        );
+    }
+}
+
+/// Issue 51, item 4: the largest coordinate a scene accepts builds a BVH and traces without a
+/// panic or a non-finite value (above it the scene itself refuses, see `shadow-core`).
+#[test]
+fn the_largest_accepted_coordinate_traces_without_panic() {
+    let big = shadow_core::scene::MAX_COORDINATE;
+    let mut b = SceneBuilder::new();
+    let f = floor(3.0, 0.0);
+    b.push_mesh(MeshDesc::new(f.0, f.1)).unwrap();
+    let o = quad(Vec3::new(0.0, 1.0, 0.0), Vec3::X * 0.5, Vec3::Z * 0.5);
+    b.push_mesh(MeshDesc::new(o.0, o.1)).unwrap();
+    b.push_mesh(MeshDesc::new(
+        vec![
+            Vec3::new(big, 0.0, 0.0),
+            Vec3::new(big, 0.0, 1.0),
+            Vec3::new(big, 1.0, 0.0),
+        ],
+        vec![[0, 1, 2]],
+    ))
+    .unwrap();
+    let scene: SceneRef = Arc::new(b.build().unwrap());
+    let light: Light = Arc::new(
+        RectLight::new(
+            Vec3::new(0.0, 3.0, 0.0),
+            Vec3::X * 0.4,
+            Vec3::Z * 0.4,
+            Radiance::Constant(Vec3::ONE),
+        )
+        .unwrap(),
+    );
+    let camera = Camera::look_at(Vec3::new(0.0, 4.0, 4.0), Vec3::ZERO, Vec3::Y, 0.9).unwrap();
+    let view = ViewSamples::render(scene.as_ref(), &camera, 24, 24).unwrap();
+    let est = Reference::stratified(16, 1)
+        .unwrap()
+        .prepare(scene, light)
+        .unwrap()
+        .estimate(&view, Outputs::VISIBILITY)
+        .unwrap();
+    est.visibility.validate().unwrap();
 }

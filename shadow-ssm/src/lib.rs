@@ -21,10 +21,10 @@
 //!
 //! let setup = shadow_core::scenes::builtin("quad-over-plane").unwrap();
 //! let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 32, 24).unwrap();
-//! let mut pcss = ShadowMapFilter::new("pcss", Filter::Pcss, 256);
-//! pcss.prepare(setup.scene.clone(), setup.lights[0].clone()).unwrap();
-//! let est = pcss.estimate(&view).unwrap();
-//! assert!(est.stats.counter("pixels-umbra") > 0);
+//! let pcss = ShadowMapFilter::new("pcss", Filter::Pcss, 256);
+//! let prepared = pcss.prepare(setup.scene.clone(), setup.lights[0].clone()).unwrap();
+//! let est = prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
+//! assert!(est.stats.counter("pixels-umbra").unwrap() > 0);
 //! ```
 
 #![deny(missing_docs)]

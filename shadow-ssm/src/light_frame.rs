@@ -4,7 +4,7 @@
 
 use glam::{DVec3, Vec3};
 use shadow_core::light::{AreaLight, LightGeometry};
-use shadow_core::technique::TechniqueError;
+use shadow_core::technique::{TechniqueError, UnsupportedReason};
 
 /// Sides of the polygon standing for a disk light.
 const DISK_SIDES: usize = 64;
@@ -62,12 +62,17 @@ impl LightFrame {
                 (normal, v)
             }
             LightGeometry::Sphere { .. } | LightGeometry::Point { .. } => {
-                return Err(TechniqueError::Unsupported {
-                    technique: technique.into(),
-                    reason: "shadow mapping needs a planar light (its near plane is parallel to \
-                             the light, GBP07 section 3); sphere and point lights have none"
-                        .into(),
-                });
+                return Err(TechniqueError::unsupported(
+                    technique,
+                    UnsupportedReason::Light {
+                        kind: light.kind(),
+                        detail: Some(
+                            "shadow mapping needs a planar light (its near plane is parallel \
+                             to the light, GBP07 section 3); sphere and point lights have none"
+                                .into(),
+                        ),
+                    },
+                ));
             }
         };
         let center = light.center();

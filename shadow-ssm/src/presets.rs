@@ -36,6 +36,7 @@ pub fn presets() -> Vec<Preset> {
             },
             budget: |s| budget(budgets::PCF, budgets::PCF_FALSE_SHADOW, s),
             with_samples: None,
+            known_limitations: &[],
         },
         Preset {
             name: "pcss",
@@ -43,6 +44,7 @@ pub fn presets() -> Vec<Preset> {
             make: |_| Box::new(ShadowMapFilter::new("pcss", Filter::Pcss, RESOLUTION)),
             budget: |s| budget(budgets::PCSS, budgets::PCSS_FALSE_SHADOW, s),
             with_samples: None,
+            known_limitations: &[],
         },
         Preset {
             name: "ssm-backprojection",
@@ -66,6 +68,7 @@ pub fn presets() -> Vec<Preset> {
                 )
             },
             with_samples: None,
+            known_limitations: &[],
         },
         Preset {
             name: "ssm-peeling",
@@ -83,6 +86,7 @@ pub fn presets() -> Vec<Preset> {
             },
             budget: |s| budget(budgets::PEELING, budgets::PEELING_FALSE_SHADOW, s),
             with_samples: None,
+            known_limitations: &[],
         },
         Preset {
             name: "ssm-contours",
@@ -96,6 +100,7 @@ pub fn presets() -> Vec<Preset> {
             },
             budget: |s| budget(budgets::CONTOURS, budgets::CONTOURS_FALSE_SHADOW, s),
             with_samples: None,
+            known_limitations: &[],
         },
         Preset {
             name: "ssm-adaptive",
@@ -111,6 +116,7 @@ pub fn presets() -> Vec<Preset> {
             },
             budget: |s| budget(budgets::ADAPTIVE, budgets::ADAPTIVE_FALSE_SHADOW, s),
             with_samples: None,
+            known_limitations: &[],
         },
     ]
 }

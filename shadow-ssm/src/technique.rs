@@ -81,13 +81,28 @@ struct Prepared {
 }
 
 /// A soft-shadow filter on a light-centre shadow map.
+#[derive(Clone)]
 pub struct ShadowMapFilter {
     name: String,
     filter: Filter,
     resolution: u32,
     peeling_layers: u32,
     screen_space: Option<ScreenSpace>,
-    prepared: Option<Prepared>,
+}
+
+/// A filter prepared for one scene and light.
+struct PreparedFilter {
+    config: ShadowMapFilter,
+    p: Prepared,
+    stats: Stats,
+}
+
+impl std::fmt::Debug for PreparedFilter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PreparedFilter")
+            .field("config", &self.config)
+            .finish_non_exhaustive()
+    }
 }
 
 impl std::fmt::Debug for ShadowMapFilter {
@@ -160,7 +175,6 @@ impl ShadowMapFilter {
             resolution,
             peeling_layers: 3,
             screen_space: None,
-            prepared: None,
         }
     }
 
@@ -353,37 +367,66 @@ impl ShadowTechnique for ShadowMapFilter {
         })
     }
 
-    fn prepare(&mut self, scene: SceneRef, light: Light) -> Result<Stats, TechniqueError> {
-        self.prepared = None;
+    fn prepare(
+        &self,
+        scene: SceneRef,
+        light: Light,
+    ) -> Result<Box<dyn PreparedShadows>, TechniqueError> {
         self.capabilities()
-            .check(scene.as_ref(), light.as_ref())
-            .map_err(|reason| TechniqueError::Unsupported {
-                technique: self.name.clone(),
-                reason,
-            })?;
+            .require(&self.name, scene.as_ref(), light.as_ref())?;
         if light.is_textured() && light.kind() != LightKind::Rectangle {
-            return Err(TechniqueError::Unsupported {
-                technique: self.name.clone(),
-                reason: "textured lights are integrated on rectangle lights only".into(),
-            });
+            return Err(TechniqueError::unsupported(
+                &self.name,
+                UnsupportedReason::Light {
+                    kind: light.kind(),
+                    detail: Some("textured lights are integrated on rectangle lights only".into()),
+                },
+            ));
         }
-        let frame = LightFrame::new(light.as_ref(), &self.name)?;
+        let mut stats = Stats::default();
+        let frame = stats.time("light-frame", || {
+            LightFrame::new(light.as_ref(), &self.name)
+        })?;
         let extent = scene.bounds().union(light.bounds()).diagonal();
-        self.prepared = Some(Prepared {
-            scene,
-            light,
-            frame,
-            offset: RayOffset::for_extent(extent),
-            extent,
-        });
-        Ok(Stats::default())
+        Ok(Box::new(PreparedFilter {
+            config: self.clone(),
+            p: Prepared {
+                scene,
+                light,
+                frame,
+                offset: RayOffset::for_extent(extent),
+                extent,
+            },
+            stats,
+        }))
+    }
+}
+
+impl PreparedShadows for PreparedFilter {
+    fn name(&self) -> &str {
+        &self.config.name
     }
 
-    fn estimate(&mut self, view: &ViewSamples) -> Result<Estimate, TechniqueError> {
-        let p = self
-            .prepared
-            .as_ref()
-            .ok_or_else(|| TechniqueError::NotPrepared(self.name.clone()))?;
+    fn preparation(&self) -> &Stats {
+        &self.stats
+    }
+
+    fn estimate(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError> {
+        if outputs.direct {
+            return Err(TechniqueError::unsupported(
+                &self.config.name,
+                UnsupportedReason::Configuration(
+                    "shadow-map filters have no light samples to shade direct light from".into(),
+                ),
+            ));
+        }
+        self.config.run(&self.p, view)
+    }
+}
+
+impl ShadowMapFilter {
+    /// The estimate of `view` on prepared data `p`.
+    fn run(&self, p: &Prepared, view: &ViewSamples) -> Result<Estimate, TechniqueError> {
         let mut stats = Stats::default();
         let n = view.len();
         let horizon: Vec<f32> = stats.time("horizon", || {
@@ -654,9 +697,6 @@ impl ShadowTechnique for ShadowMapFilter {
         stats.add("pixels-blended", counts.blended);
         stats.add("samples-read", counts.read);
         vis.validate()?;
-        Ok(Estimate {
-            visibility: vis,
-            stats,
-        })
+        Ok(Estimate::new(vis, stats))
     }
 }

@@ -78,10 +78,14 @@ fn pcss_is_closer_to_the_reference_than_pcf_under_a_planar_occluder() {
     let setup = shadow_core::scenes::builtin("quad-over-plane").unwrap();
     let view =
         ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 64, 48).unwrap();
-    let run = |t: &mut dyn ShadowTechnique| {
-        t.prepare(setup.scene.clone(), setup.lights[0].clone())
+    let run = |t: &dyn ShadowTechnique| {
+        let t_prepared = t
+            .prepare(setup.scene.clone(), setup.lights[0].clone())
             .unwrap();
-        t.estimate(&view).unwrap().visibility
+        t_prepared
+            .estimate(&view, Outputs::VISIBILITY)
+            .unwrap()
+            .visibility
     };
     let truth = run(&mut shadow_ref::Reference::stratified(512, 3).unwrap());
     let pcss = compare(
@@ -102,7 +106,7 @@ fn pcss_is_closer_to_the_reference_than_pcf_under_a_planar_occluder() {
     assert!(pcf.rmse > 3.0 * pcss.rmse, "{pcf:?} {pcss:?}");
     // Sphere lights are refused with the reason.
     let sphere = shadow_core::scenes::builtin("sphere-light").unwrap();
-    let mut t = ShadowMapFilter::new("pcss", Filter::Pcss, 64);
+    let t = ShadowMapFilter::new("pcss", Filter::Pcss, 64);
     let err = t
         .prepare(sphere.scene.clone(), sphere.lights[0].clone())
         .unwrap_err();

@@ -124,9 +124,9 @@ impl SceneContext {
         self.reference
             .get_or_init(|| {
                 let seed = self.config.seed ^ REFERENCE_SEED_SALT;
-                let mut r = Reference::stratified(self.config.ref_samples, seed)
+                let r = Reference::stratified(self.config.ref_samples, seed)
                     .map_err(|e| e.to_string())?;
-                run_technique(&mut r, &self.setup, self.light(), &self.view)
+                run_technique(&r, &self.setup, self.light(), &self.view)
                     .map(|(e, _, secs)| (e.visibility, secs))
                     .map_err(|e| e.to_string())
             })
@@ -135,21 +135,30 @@ impl SceneContext {
     }
 }
 
-/// Prepares and runs a technique; returns the estimate, the prepare stats and the wall time of
-/// prepare plus estimate.
+/// Prepares and runs a technique (with per-sample visibility when it is sample-based); returns
+/// the estimate, the prepare stats and the wall time of prepare plus estimate.
 ///
 /// # Errors
 /// The technique's error.
 pub fn run_technique(
-    tech: &mut dyn ShadowTechnique,
+    tech: &dyn ShadowTechnique,
     setup: &SceneSetup,
     light: Light,
     view: &ViewSamples,
 ) -> Result<(Estimate, Stats, f64), TechniqueError> {
+    let outputs = if tech.capabilities().sample_based {
+        Outputs::PER_SAMPLE
+    } else {
+        Outputs::VISIBILITY
+    };
     let t0 = Instant::now();
-    let prep = tech.prepare(setup.scene.clone(), light)?;
-    let est = tech.estimate(view)?;
-    Ok((est, prep, t0.elapsed().as_secs_f64()))
+    let prepared = tech.prepare(setup.scene.clone(), light)?;
+    let est = prepared.estimate(view, outputs)?;
+    Ok((
+        est,
+        prepared.preparation().clone(),
+        t0.elapsed().as_secs_f64(),
+    ))
 }
 
 /// What happened to one (preset, scene) case.
@@ -158,7 +167,7 @@ pub enum Outcome {
     /// The preset does not support the scene; the reason says why.
     Unsupported {
         /// Why.
-        reason: String,
+        reason: UnsupportedReason,
     },
     /// The technique failed with an error (a conformance failure).
     Failed {
@@ -283,13 +292,13 @@ fn check_budget(
 /// Runs every check for `preset` on the scene of `ctx`.
 pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
     let cfg = ctx.config;
-    let mut tech = (preset.make)(cfg.seed);
+    let tech = (preset.make)(cfg.seed);
     let caps = tech.capabilities();
     if let Err(reason) = caps.check(ctx.setup.scene.as_ref(), ctx.light().as_ref()) {
         return Outcome::Unsupported { reason };
     }
     let (est, prep, seconds) =
-        match run_technique(tech.as_mut(), &ctx.setup, ctx.light(), &ctx.view) {
+        match run_technique(tech.as_ref(), &ctx.setup, ctx.light(), &ctx.view) {
             Ok(r) => r,
             Err(TechniqueError::Unsupported { reason, .. }) => {
                 return Outcome::Unsupported { reason };
@@ -307,8 +316,8 @@ pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
     let same = caps.sample_based && tech.light_sampler().is_some();
     let (reference, reference_seconds) = if same {
         let sampler = tech.light_sampler().expect("checked above").clone();
-        let mut r = Reference::same_samples(sampler);
-        match run_technique(&mut r, &ctx.setup, ctx.light(), &ctx.view) {
+        let r = Reference::same_samples(sampler);
+        match run_technique(&r, &ctx.setup, ctx.light(), &ctx.view) {
             Ok((e, _, s)) => (e.visibility, s),
             Err(e) => {
                 return Outcome::Failed {
@@ -373,13 +382,13 @@ pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
         let first = if ctx.config == cfg {
             Ok(est.visibility.coefficients().clone())
         } else {
-            let mut t = (preset.make)(cfg.seed);
-            run_technique(t.as_mut(), &ctx.setup, ctx.light(), &ctx.view)
+            let t = (preset.make)(cfg.seed);
+            run_technique(t.as_ref(), &ctx.setup, ctx.light(), &ctx.view)
                 .map(|(e, _, _)| e.visibility.coefficients().clone())
         };
-        let mut again = (preset.make)(cfg.seed);
+        let again = (preset.make)(cfg.seed);
         match first.and_then(|first| {
-            run_technique(again.as_mut(), &ctx.setup, ctx.light(), &ctx.view).map(|r| (first, r))
+            run_technique(again.as_ref(), &ctx.setup, ctx.light(), &ctx.view).map(|r| (first, r))
         }) {
             Ok((first, (e2, _, _))) => {
                 let same_output = *e2.visibility.coefficients() == first;
@@ -393,14 +402,13 @@ pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
         }
         if let Some(with) = preset.with_samples {
             let rmse_at = |n: u32| -> Result<f64, String> {
-                let mut t = with(n, cfg.seed);
-                let (e, _, _) = run_technique(t.as_mut(), &ctx.setup, ctx.light(), &ctx.view)
+                let t = with(n, cfg.seed).map_err(|e| e.to_string())?;
+                let (e, _, _) = run_technique(t.as_ref(), &ctx.setup, ctx.light(), &ctx.view)
                     .map_err(|e| e.to_string())?;
                 let r = if t.capabilities().sample_based {
-                    let mut r =
-                        Reference::stratified(cfg.ref_samples, cfg.seed ^ REFERENCE_SEED_SALT)
-                            .map_err(|e| e.to_string())?;
-                    run_technique(&mut r, &ctx.setup, ctx.light(), &ctx.view)
+                    let r = Reference::stratified(cfg.ref_samples, cfg.seed ^ REFERENCE_SEED_SALT)
+                        .map_err(|e| e.to_string())?;
+                    run_technique(&r, &ctx.setup, ctx.light(), &ctx.view)
                         .map_err(|e| e.to_string())?
                         .0
                         .visibility
@@ -468,10 +476,10 @@ pub fn reference_curve(ctx: &SceneContext, counts: &[u32]) -> Result<Vec<CurvePo
     counts
         .iter()
         .map(|&n| {
-            let mut r =
+            let r =
                 Reference::stratified(n, ctx.config.seed ^ 0xc0ffee).map_err(|e| e.to_string())?;
-            let (e, _, secs) = run_technique(&mut r, &ctx.setup, ctx.light(), &ctx.view)
-                .map_err(|e| e.to_string())?;
+            let (e, _, secs) =
+                run_technique(&r, &ctx.setup, ctx.light(), &ctx.view).map_err(|e| e.to_string())?;
             let m = compare(&e.visibility, high).map_err(|e| e.to_string())?;
             Ok(CurvePoint {
                 samples: n,

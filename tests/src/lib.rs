@@ -52,3 +52,8 @@ pub fn preset(name: &str) -> Result<Preset, String> {
         )
     })
 }
+
+/// The README's code blocks, compiled and run as doctests so that the README stays true.
+#[cfg(doctest)]
+#[doc = include_str!("../../README.md")]
+pub struct ReadmeDoctests;

@@ -32,29 +32,13 @@ pub struct StressResult {
     pub detail: String,
 }
 
-/// Stress cases a preset fails by design, with the reason: the suite asserts they still fail
-/// (the limitation is real and shown), and every other case must hold.
-pub const KNOWN_LIMITATIONS: &[(&str, &str, &str)] = &[
-    (
-        "dcs-standard-silhouettes",
-        "light-larger-than-scene",
-        "silhouettes seen from the centre of a light 300 times the occluder miss most of the \
-         penumbra (DCS Fig. 4, the artifact the preset exists to show)",
-    ),
-    (
-        "dcs-64-discrete",
-        "light-larger-than-scene",
-        "the line table of DCS section 7.3 spans the light's square, so on a light 300 times \
-         the occluder one cell is wider than the projected occluder; the exact and refined modes hold",
-    ),
-];
-
-/// The reason `preset` is known to fail `case`, if it is.
-pub fn known_limitation(preset: &str, case: &str) -> Option<&'static str> {
-    KNOWN_LIMITATIONS
+/// The reason `preset` is known to fail `case` ([`Preset::known_limitations`]), if it is.
+pub fn known_limitation(preset: &Preset, case: &str) -> Option<&'static str> {
+    preset
+        .known_limitations
         .iter()
-        .find(|(p, c, _)| *p == preset && *c == case)
-        .map(|(_, _, r)| *r)
+        .find(|(c, _)| *c == case)
+        .map(|(_, r)| *r)
 }
 
 fn result(case: &str, technique: &str, held: bool, detail: String) -> StressResult {
@@ -164,10 +148,11 @@ fn run_on(
     view: &ViewSamples,
     seed: u64,
 ) -> Result<(VisibilityImage, bool, Option<LightSampler>), String> {
-    let mut t = (preset.make)(seed);
+    let t = (preset.make)(seed);
     let caps = t.capabilities();
-    caps.check(setup.scene.as_ref(), setup.lights[0].as_ref())?;
-    let (e, _, _) = run_technique(t.as_mut(), setup, setup.lights[0].clone(), view)
+    caps.check(setup.scene.as_ref(), setup.lights[0].as_ref())
+        .map_err(|r| r.to_string())?;
+    let (e, _, _) = run_technique(t.as_ref(), setup, setup.lights[0].clone(), view)
         .map_err(|e| e.to_string())?;
     e.visibility.validate().map_err(|e| e.to_string())?;
     let sampler = (caps.sample_based)
@@ -181,11 +166,11 @@ fn reference_for(
     view: &ViewSamples,
     sampler: Option<LightSampler>,
 ) -> VisibilityImage {
-    let mut r = match sampler {
+    let r = match sampler {
         Some(s) => Reference::same_samples(s),
         None => Reference::stratified(256, 77).expect("valid"),
     };
-    run_technique(&mut r, setup, setup.lights[0].clone(), view)
+    run_technique(&r, setup, setup.lights[0].clone(), view)
         .expect("the reference runs on stress scenes")
         .0
         .visibility
@@ -227,6 +212,19 @@ pub fn technique_cases(preset: &Preset, width: u32, height: u32) -> Vec<StressRe
         .map_or(0.05, |r| r.max(0.01) * 2.0);
     let invariance = 0.02;
     let base = builtin("quad-over-plane").expect("built-in");
+    // Without a GPU adapter (and without `SHADOW_REQUIRE_GPU`, which makes it an error) a GPU
+    // preset has nothing to stress: one loud line says so.
+    if let Err(e) = (preset.make)(3).prepare(base.scene.clone(), base.lights[0].clone())
+        && let Some(UnsupportedReason::NoAdapter(m)) = e.unsupported_reason()
+    {
+        eprintln!("SKIPPED stress cases of {name}: no GPU adapter: {m}");
+        return vec![result(
+            "no-gpu-adapter",
+            name,
+            true,
+            format!("SKIPPED: {m}"),
+        )];
+    }
     let view_of = |s: &SceneSetup| {
         ViewSamples::render(s.scene.as_ref(), &s.camera_or_default(), width, height)
             .expect("valid view")
@@ -383,8 +381,8 @@ pub fn technique_cases(preset: &Preset, width: u32, height: u32) -> Vec<StressRe
     let view = view_of(&tiny);
     out.push(match run_on(preset, &tiny, &view, 3) {
         Ok((v, ..)) => {
-            let mut hard = Reference::hard();
-            let h = run_technique(&mut hard, &tiny, tiny.lights[0].clone(), &view)
+            let hard = Reference::hard();
+            let h = run_technique(&hard, &tiny, tiny.lights[0].clone(), &view)
                 .expect("reference runs")
                 .0
                 .visibility;

@@ -216,8 +216,8 @@ pub fn run(a: BenchArgs) -> Result<(), String> {
         )
         .map_err(|e| e.to_string())?;
         pb.set_message(format!("{scene}: ground truth"));
-        let mut truth = Reference::stratified(truth_samples, 0xfeed).map_err(|e| e.to_string())?;
-        let truth = run_technique(&mut truth, &setup, setup.lights[0].clone(), &view)
+        let truth = Reference::stratified(truth_samples, 0xfeed).map_err(|e| e.to_string())?;
+        let truth = run_technique(&truth, &setup, setup.lights[0].clone(), &view)
             .map_err(|e| e.to_string())?
             .0
             .visibility;
@@ -261,7 +261,9 @@ pub fn run(a: BenchArgs) -> Result<(), String> {
             match p.with_samples {
                 Some(f) => {
                     // Presets that differ only in their default sample count share one sweep.
-                    let params = without_samples(f(sweep[0], seed).parameters());
+                    let make =
+                        |n: u32| f(n, seed).map_err(|e| format!("{} at {n} samples: {e}", p.name));
+                    let params = without_samples(make(sweep[0])?.parameters());
                     if let Some(first) = swept
                         .iter()
                         .find(|(q, _)| *q == params)
@@ -273,7 +275,9 @@ pub fn run(a: BenchArgs) -> Result<(), String> {
                     }
                     swept.push((params, p.name.to_string()));
                     for &n in &sweep {
-                        record(p.name, Some(n), &|| f(n, seed))?;
+                        // A count out of the preset's range is an error here, before timing.
+                        make(n)?;
+                        record(p.name, Some(n), &|| f(n, seed).expect("checked above"))?;
                         pb.inc(1);
                     }
                 }
@@ -368,8 +372,8 @@ pub fn run(a: BenchArgs) -> Result<(), String> {
         pool.install(|| {
             let mut best: f64 = 0.0;
             for _ in 0..=a.repeats {
-                let mut r = Reference::stratified(64, seed).expect("valid");
-                let (e, _, _) = run_technique(&mut r, &bunny, bunny.lights[0].clone(), &view)
+                let r = Reference::stratified(64, seed).expect("valid");
+                let (e, _, _) = run_technique(&r, &bunny, bunny.lights[0].clone(), &view)
                     .map_err(|e| e.to_string())?;
                 best = best.max(rays_per_second_per_thread(&e.stats).unwrap_or(0.0));
             }
@@ -554,11 +558,12 @@ fn query_throughput(
 ) -> Result<QueryThroughput, String> {
     let view = ViewSamples::render(bunny.scene.as_ref(), &bunny.camera_or_default(), 160, 120)
         .map_err(|e| e.to_string())?;
-    let mut r = Reference::stratified(64, seed).map_err(|e| e.to_string())?;
-    r.prepare(bunny.scene.clone(), bunny.lights[0].clone())
+    let r = Reference::stratified(64, seed)
+        .map_err(|e| e.to_string())?
+        .prepare_reference(bunny.scene.clone(), bunny.lights[0].clone())
         .map_err(|e| e.to_string())?;
-    let segs = r.segments(&view).map_err(|e| e.to_string())?;
-    let bvh = r.bvh().ok_or("reference not prepared")?;
+    let segs = r.segments(&view);
+    let bvh = r.bvh();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
@@ -591,15 +596,13 @@ fn query_throughput(
             // same view answers the same segments.
             let mut trace_best = f64::INFINITY;
             for _ in 0..=a.repeats {
-                let mut r = Reference::stratified(64, seed).map_err(|e| e.to_string())?;
-                let (e, _, _) = run_technique(&mut r, bunny, bunny.lights[0].clone(), &view)
+                let r = Reference::stratified(64, seed).map_err(|e| e.to_string())?;
+                let (e, _, _) = run_technique(&r, bunny, bunny.lights[0].clone(), &view)
                     .map_err(|e| e.to_string())?;
                 let secs = e
                     .stats
-                    .phases
-                    .iter()
-                    .find(|p| p.name == "trace")
-                    .map_or(f64::INFINITY, |p| p.seconds);
+                    .phase_seconds(shadow_ref::reference::TRACE_PHASE)
+                    .unwrap_or(f64::INFINITY);
                 trace_best = trace_best.min(secs);
             }
             Ok((best, cwbvh_best, occluded, trace_best))

@@ -59,7 +59,7 @@ pub fn resolve_technique(
     match samples {
         None => Ok((p.make)(seed)),
         Some(n) => match p.with_samples {
-            Some(f) => Ok(f(n, seed)),
+            Some(f) => f(n, seed).map_err(|e| format!("technique `{name}` at {n} samples: {e}")),
             None => Err(format!("technique `{name}` has no sample count to set")),
         },
     }
@@ -169,8 +169,11 @@ pub fn write_json(path: &Path, value: &impl Serialize) -> Result<(), String> {
 
 /// Occlusion rays per second per thread from a technique's estimate stats, when it counts rays.
 pub fn rays_per_second_per_thread(stats: &Stats) -> Option<f64> {
-    let rays = stats.counter("occlusion-rays");
-    let threads = stats.counter("threads").max(1);
-    let secs = stats.phases.iter().find(|p| p.name == "trace")?.seconds;
+    let rays = stats.counter(shadow_ref::reference::RAYS_COUNTER)?;
+    let threads = stats
+        .gauge(shadow_ref::reference::THREADS_GAUGE)
+        .unwrap_or(1)
+        .max(1);
+    let secs = stats.phase_seconds(shadow_ref::reference::TRACE_PHASE)?;
     (rays > 0 && secs > 0.0).then(|| rays as f64 / secs / threads as f64)
 }

@@ -36,8 +36,9 @@ pub struct RenderArgs {
     /// Seed of the technique's sampling.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Also write the reference's direct illumination (DCS eq. 6, diffuse albedo, the same
-    /// sample count: `--samples`, default 256) as `direct.exr` and `direct.png`.
+    /// Also write the direct illumination (DCS eq. 6, diffuse albedo) as `direct.exr` and
+    /// `direct.png`: the technique's own, from its per-sample visibility (sample-based
+    /// techniques), or without `--technique` the reference's at `--samples` (default 256).
     #[arg(long)]
     direct: bool,
     /// Output directory.
@@ -47,7 +48,7 @@ pub struct RenderArgs {
 
 pub fn run(a: RenderArgs) -> Result<(), String> {
     let setup = resolve_scene(&a.scene)?;
-    let mut technique = match &a.technique {
+    let technique = match &a.technique {
         Some(t) => Some(resolve_technique(t, a.samples, a.seed)?),
         None => None,
     };
@@ -82,15 +83,29 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         "view_samples_seconds": view_seconds,
         "machine": machine(),
     });
-    if let Some(t) = technique.as_mut() {
+    if let Some(t) = technique.as_ref() {
         pb.set_message(format!("{}: prepare", t.name()));
-        let prep = t
+        let prepared = t
             .prepare(setup.scene.clone(), setup.lights[0].clone())
             .map_err(|e| e.to_string())?;
         pb.inc(1);
         pb.set_message(format!("{}: estimate", t.name()));
-        let est = t.estimate(&view).map_err(|e| e.to_string())?;
+        let outputs = Outputs {
+            per_sample: false,
+            direct: a.direct,
+        };
+        let est = prepared
+            .estimate(&view, outputs)
+            .map_err(|e| e.to_string())?;
         pb.inc(1);
+        if let Some(direct) = &est.direct {
+            write_direct(&a.out, &view, direct)?;
+            stats["direct_illumination"] = json!({
+                "technique": t.name(),
+                "samples": t.light_sampler().map(|s| s.count()),
+                "seconds": est.stats.phase_seconds("direct"),
+            });
+        }
         write_visibility_exr(&a.out.join("visibility.exr"), &est.visibility)
             .map_err(|e| e.to_string())?;
         write_visibility_png(&a.out.join("visibility.png"), &est.visibility)
@@ -106,25 +121,29 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         stats["technique"] = json!(t.name());
         stats["parameters"] = t.parameters();
         stats["samples"] = t.light_sampler().map_or(json!(null), |s| json!(s.count()));
-        stats["prepare"] = serde_json::to_value(&prep).map_err(|e| e.to_string())?;
+        stats["prepare"] =
+            serde_json::to_value(prepared.preparation()).map_err(|e| e.to_string())?;
         stats["estimate"] = serde_json::to_value(&est.stats).map_err(|e| e.to_string())?;
         stats["classes"] = json!(est.visibility.class_counts());
         if let Some(r) = rays_per_second_per_thread(&est.stats) {
             stats["occlusion_rays_per_second_per_thread"] = json!(r);
         }
     }
-    if a.direct {
+    if a.direct && technique.is_none() {
         pb.set_message("direct illumination");
-        let mut r = shadow_ref::Reference::stratified(a.samples.unwrap_or(256), a.seed)
+        let r = shadow_ref::Reference::stratified(a.samples.unwrap_or(256), a.seed)
             .map_err(|e| e.to_string())?;
         let t0 = Instant::now();
-        r.prepare(setup.scene.clone(), setup.lights[0].clone())
+        let prepared = r
+            .prepare_reference(setup.scene.clone(), setup.lights[0].clone())
             .map_err(|e| e.to_string())?;
-        let direct = r.direct_illumination(&view).map_err(|e| e.to_string())?;
-        write_rgb_exr(&a.out.join("direct.exr"), &view, &direct).map_err(|e| e.to_string())?;
-        write_radiance_png(&a.out.join("direct.png"), &view, &direct).map_err(|e| e.to_string())?;
-        stats["direct_illumination"] =
-            json!({"samples": a.samples.unwrap_or(256), "seconds": t0.elapsed().as_secs_f64()});
+        let direct = prepared.direct_illumination(&view);
+        write_direct(&a.out, &view, &direct)?;
+        stats["direct_illumination"] = json!({
+            "technique": r.name(),
+            "samples": a.samples.unwrap_or(256),
+            "seconds": t0.elapsed().as_secs_f64(),
+        });
     }
     pb.finish_and_clear();
     write_json(&a.out.join("stats.json"), &stats)?;
@@ -136,4 +155,14 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         view.valid_count()
     );
     Ok(())
+}
+
+/// Writes direct illumination as `direct.exr` and `direct.png` in `out`.
+fn write_direct(
+    out: &std::path::Path,
+    view: &ViewSamples,
+    direct: &[glam::Vec3],
+) -> Result<(), String> {
+    write_rgb_exr(&out.join("direct.exr"), view, direct).map_err(|e| e.to_string())?;
+    write_radiance_png(&out.join("direct.png"), view, direct).map_err(|e| e.to_string())
 }

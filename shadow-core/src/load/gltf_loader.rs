@@ -43,8 +43,13 @@ pub fn load_gltf_slice(
     name: &str,
     limits: &LoadLimits,
 ) -> Result<SceneSetup, LoadError> {
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| LoadError::Gltf(e.to_string()))?;
-    let doc = gltf.document;
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes)
+        .map_err(|e| LoadError::Gltf(e.to_string()))?;
+    // gltf-json's validation dereferences a primitive's POSITION accessor unchecked (a missing
+    // one panics): every index a primitive names is checked here first.
+    check_primitive_indices(gltf.document.as_json())?;
+    let doc = gltf::Document::from_json(gltf.document.into_json())
+        .map_err(|e| LoadError::Gltf(e.to_string()))?;
     let buffers = load_buffers(&doc, gltf.blob, base, limits)?;
     let mut builder = SceneBuilder::new().degenerate_policy(DegeneratePolicy::Drop);
     let mut lights: Vec<Light> = Vec::new();
@@ -340,7 +345,11 @@ fn elements<'a>(
         .get(view.buffer().index())
         .ok_or_else(|| LoadError::Missing(format!("buffer {}", view.buffer().index())))?;
     let (voff, vlen) = (view.offset() as u64, view.length() as u64);
-    if voff + vlen > buf.len() as u64 {
+    // Offsets near 2^64 must not wrap the checks: every sum below is checked.
+    if voff
+        .checked_add(vlen)
+        .is_none_or(|end| end > buf.len() as u64)
+    {
         return Err(LoadError::Accessor(format!(
             "buffer view {} exceeds its buffer",
             view.index()
@@ -363,7 +372,11 @@ fn elements<'a>(
         )));
     }
     let off = acc.offset() as u64;
-    if count > 0 && off + (count - 1) * stride + elem > vlen {
+    let end = (count.max(1) - 1)
+        .checked_mul(stride)
+        .and_then(|x| x.checked_add(off))
+        .and_then(|x| x.checked_add(elem));
+    if count > 0 && end.is_none_or(|end| end > vlen) {
         return Err(LoadError::Accessor(format!(
             "accessor {} reads past its buffer view",
             acc.index()
@@ -376,6 +389,51 @@ fn elements<'a>(
             &buf[s..s + elem as usize]
         })
         .collect())
+}
+
+/// Every accessor and material a mesh primitive (or its morph targets) names exists.
+fn check_primitive_indices(root: &gltf::json::Root) -> Result<(), LoadError> {
+    let accessors = root.accessors.len();
+    let bad = |what: String| Err(LoadError::Missing(what));
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (k, prim) in mesh.primitives.iter().enumerate() {
+            let at = || format!("mesh {m} primitive {k}");
+            for (semantic, acc) in &prim.attributes {
+                if acc.value() >= accessors {
+                    return bad(format!(
+                        "accessor {} (attribute {semantic:?} of {}; the file has {accessors})",
+                        acc.value(),
+                        at()
+                    ));
+                }
+            }
+            if let Some(i) = prim.indices
+                && i.value() >= accessors
+            {
+                return bad(format!("accessor {} (indices of {})", i.value(), at()));
+            }
+            if let Some(mat) = prim.material
+                && mat.value() >= root.materials.len()
+            {
+                return bad(format!("material {} (of {})", mat.value(), at()));
+            }
+            for target in prim.targets.iter().flatten() {
+                for acc in [&target.positions, &target.normals, &target.tangents]
+                    .into_iter()
+                    .flatten()
+                {
+                    if acc.value() >= accessors {
+                        return bad(format!(
+                            "accessor {} (morph target of {})",
+                            acc.value(),
+                            at()
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 fn check_type(acc: &gltf::Accessor, dims: Dimensions, types: &[DataType]) -> Result<(), LoadError> {
@@ -488,7 +546,8 @@ fn load_image(
                 .get(view.buffer().index())
                 .ok_or_else(|| LoadError::Missing(format!("buffer {}", view.buffer().index())))?;
             let (o, l) = (view.offset(), view.length());
-            buf.get(o..o + l)
+            o.checked_add(l)
+                .and_then(|end| buf.get(o..end))
                 .ok_or_else(|| {
                     LoadError::Texture(format!("image view {} exceeds its buffer", view.index()))
                 })?

@@ -49,14 +49,14 @@ pub fn preset(name: &str, what: &str) -> Result<Preset, String> {
 /// `runs` estimates of `view`: the best wall time and the last estimate (`None` for no run).
 pub fn best_of(
     runs: u32,
-    t: &mut dyn ShadowTechnique,
+    t: &dyn PreparedShadows,
     view: &ViewSamples,
 ) -> Result<(f64, Option<Estimate>), TechniqueError> {
     let mut secs = f64::INFINITY;
     let mut last = None;
     for _ in 0..runs {
         let t0 = Instant::now();
-        let e = t.estimate(view)?;
+        let e = t.estimate(view, Outputs::VISIBILITY)?;
         secs = secs.min(t0.elapsed().as_secs_f64());
         last = Some(e);
     }
