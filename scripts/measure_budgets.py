@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Regenerates the measured-error tables behind the presets' budgets.
 
-    cargo test --profile test -p shadow-tests --test conformance every_preset_on_every \
-        -- --nocapture | grep -E '^[a-z]' | python3 scripts/measure_budgets.py FILE.rs PRESET=CONST ...
+    cargo test -p shadow-tests --test conformance -- conformance/ --test-threads 1 \
+        | grep -E '^[a-z]' | python3 scripts/measure_budgets.py FILE.rs PRESET=CONST ...
 
 Each `PRESET=CONST` pair rewrites `const CONST: &[(&str, [f64; 5])] = &[...]` in FILE.rs with
 the errors the suite printed for PRESET (rmse, penumbra rmse, bias, max, share > 0.1). Budgets

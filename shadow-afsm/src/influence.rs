@@ -26,29 +26,13 @@ pub enum Influence {
     Hull(Vec<Vec2>),
 }
 
-fn cross2(o: Vec2, a: Vec2, b: Vec2) -> f32 {
-    (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x)
-}
-
-/// Convex hull (monotone chain), counter-clockwise, collinear points dropped.
-pub fn convex_hull(mut pts: Vec<Vec2>) -> Vec<Vec2> {
-    pts.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
-    let mut h: Vec<Vec2> = Vec::with_capacity(pts.len() + 1);
-    for p in &pts {
-        while h.len() >= 2 && cross2(h[h.len() - 2], h[h.len() - 1], *p) <= 0.0 {
-            h.pop();
-        }
-        h.push(*p);
-    }
-    let lower = h.len() + 1;
-    for p in pts.iter().rev().skip(1) {
-        while h.len() >= lower && cross2(h[h.len() - 2], h[h.len() - 1], *p) <= 0.0 {
-            h.pop();
-        }
-        h.push(*p);
-    }
-    h.pop();
-    h
+/// Convex hull (monotone chain, `shadow_core::geometry::convex_hull`), counter-clockwise,
+/// collinear points dropped, in texel coordinates.
+pub fn convex_hull(pts: Vec<Vec2>) -> Vec<Vec2> {
+    shadow_core::geometry::convex_hull(pts.into_iter().map(|p| p.as_dvec2()).collect())
+        .into_iter()
+        .map(|p| p.as_vec2())
+        .collect()
 }
 
 /// The points bounding the light as seen through vertex `v`, or `None` when `v` is inside a

@@ -74,7 +74,6 @@ struct Prepared {
 /// frustum cannot hold a batch (view samples all around an omni-directional light), the batch
 /// is split by the cube face its samples lie toward, one frustum per face (each spans at most
 /// 55 degrees from its axis).
-#[allow(clippy::type_complexity)]
 fn group_receivers(
     center: Vec3,
     receivers: &[Receiver],
@@ -553,7 +552,10 @@ impl PreparedAfsm {
     ///
     /// # Errors
     /// [`TechniqueError::Device`] on a device failure.
-    #[allow(clippy::type_complexity)]
+    #[expect(
+        clippy::type_complexity,
+        reason = "the estimate, its receivers and each batch's frame, regions and offsets, read by stage tests"
+    )]
     pub fn run(
         &self,
         view: &ViewSamples,
@@ -574,7 +576,10 @@ impl Afsm {
     /// Runs the passes on `view`, keeping the last caster batch's influence regions when
     /// `keep_regions` (for stage tests). Returns the estimate, the receivers, their map frames
     /// and regions per batch.
-    #[allow(clippy::type_complexity)]
+    #[expect(
+        clippy::type_complexity,
+        reason = "the estimate, its receivers and each batch's frame, regions and offsets, read by stage tests"
+    )]
     fn run(
         &self,
         p: &Prepared,

@@ -1,6 +1,7 @@
-//! Small geometric helpers shared by every crate: axis-aligned boxes and triangle measures.
+//! Small geometric helpers shared by every crate: axis-aligned boxes, triangle measures and the
+//! planar convex hull.
 
-use glam::{DVec3, Vec3};
+use glam::{DVec2, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
 /// An axis-aligned bounding box. [`Aabb::empty`] is the identity of [`Aabb::union`].
@@ -125,6 +126,37 @@ pub fn polygon_signed_area(points: &[glam::Vec2]) -> f64 {
         s += p.x * q.y - q.x * p.y;
     }
     0.5 * s
+}
+
+/// The convex hull of planar points by Andrew's monotone chain, counter-clockwise in a y-up
+/// frame, duplicate and collinear points dropped; fewer than three distinct points come back
+/// as they are (sorted). DCS's light outline and AFSM's influence regions both take it.
+pub fn convex_hull(mut p: Vec<DVec2>) -> Vec<DVec2> {
+    p.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    p.dedup();
+    if p.len() < 3 {
+        return p;
+    }
+    let cross = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
+    let mut hull: Vec<DVec2> = Vec::with_capacity(p.len() * 2);
+    // Lower chain left to right, then upper chain right to left.
+    let chain = |hull: &mut Vec<DVec2>, q: DVec2, start: usize| {
+        while hull.len() >= start + 2 && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0
+        {
+            hull.pop();
+        }
+        hull.push(q);
+    };
+    for &q in &p {
+        chain(&mut hull, q, 0);
+    }
+    hull.pop();
+    let start = hull.len();
+    for &q in p.iter().rev() {
+        chain(&mut hull, q, start);
+    }
+    hull.pop();
+    hull
 }
 
 #[cfg(test)]

@@ -87,7 +87,7 @@ pub struct Preset {
     /// For sample-based presets: the same technique with another sample count, used by the
     /// convergence check (error must fall as samples grow).
     pub with_samples: Option<WithSamples>,
-    /// Stress cases (by name, see `shadow-tests`' stress suite) the preset fails by design, each
+    /// Stress cases (by name, see `shadow-conformance`'s stress cases) the preset fails by design, each
     /// with the reason: the suite asserts they still fail, so a limitation is shown rather than
     /// hidden, and is removed here when it no longer holds.
     pub known_limitations: &'static [(&'static str, &'static str)],

@@ -73,6 +73,10 @@ pub(crate) fn eye_constant(scene: &dyn Scene, edges_units: u32, eye: Vec3, c: Ve
 /// shadow-volume quads of `silhouettes` (edges seen from the light centre).
 ///
 /// Returns the constants and the number of quads rasterized.
+#[expect(
+    clippy::too_many_arguments,
+    reason = "the shadow-volume step reads the edges, the light centre, the eye and three per-pixel arrays together"
+)]
 pub(crate) fn integration_constants(
     edges: &[SceneEdge],
     silhouettes: &[u32],

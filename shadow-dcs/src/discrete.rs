@@ -285,7 +285,10 @@ impl DiscreteTables {
     /// `allowed`; falls back to the exact `test` where the tables cannot answer (the edge's
     /// projection passes through the centre, or the edge leaves the slab between `p` and the
     /// light plane).
-    #[allow(clippy::too_many_arguments)]
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "the table lookup reads the pixel, its test, origin, edge, samples and two masks together in the per-pair hot path"
+    )]
     pub(crate) fn mask(
         &self,
         pixel: UVec2,

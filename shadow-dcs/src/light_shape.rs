@@ -52,7 +52,7 @@ impl LightPlane {
                 glam::DVec2::new(d.dot(ud), d.dot(vd))
             })
             .collect();
-        let hull = crate::wedges::convex_hull(flat);
+        let hull = shadow_core::geometry::convex_hull(flat);
         let n = hull.len();
         // Counter-clockwise, with the centre (the origin) strictly inside.
         let inside = n >= 3

@@ -21,7 +21,7 @@
 //! shadow-volume quad splits the wedge: `k_e > 0` is the outer part (samples beyond the projected
 //! edge gain depth complexity), `k_e < 0` the inner part.
 
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::centred::{CentredPlane, FastWeight};
@@ -46,6 +46,11 @@ pub(crate) struct Plane {
 }
 
 impl Plane {
+    /// Whether `x` lies in the half-space.
+    pub(crate) fn contains(&self, x: DVec3) -> bool {
+        self.n.dot(x) + self.d >= 0.0
+    }
+
     /// The plane around the light centre `c`, in single precision.
     fn centred(&self, c: DVec3) -> CentredPlane {
         CentredPlane::new(self.n, self.d, c)
@@ -263,36 +268,6 @@ pub(crate) fn fold_planes(e: &SceneEdge) -> Option<(Plane, Plane)> {
 
 /// Slack of the fold prefilter (distance), relative to the scene's extent.
 pub(crate) const FOLD_SLACK: f64 = 1e-6;
-
-/// Andrew's monotone chain; counter-clockwise in a y-up frame (orientation is irrelevant to the
-/// scan).
-pub(crate) fn convex_hull(mut p: Vec<DVec2>) -> Vec<DVec2> {
-    p.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
-    p.dedup();
-    if p.len() < 3 {
-        return p;
-    }
-    let cross = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
-    let mut hull: Vec<DVec2> = Vec::with_capacity(p.len() * 2);
-    // Lower chain left to right, then upper chain right to left.
-    let chain = |hull: &mut Vec<DVec2>, q: DVec2, start: usize| {
-        while hull.len() >= start + 2 && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0
-        {
-            hull.pop();
-        }
-        hull.push(q);
-    };
-    for &q in &p {
-        chain(&mut hull, q, 0);
-    }
-    hull.pop();
-    let start = hull.len();
-    for &q in p.iter().rev() {
-        chain(&mut hull, q, start);
-    }
-    hull.pop();
-    hull
-}
 
 #[cfg(test)]
 mod tests {

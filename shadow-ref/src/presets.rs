@@ -3,7 +3,7 @@
 //! point-light hard shadow as a baseline.
 //!
 //! Budgets are errors measured by the conformance suite (128 x 96 pixels, seed 1, reference at
-//! 1024 samples; `cargo test -p shadow-tests -- --nocapture` prints them) with the margins of
+//! 1024 samples; `cargo test -p shadow-tests --test conformance -- conformance/` prints them) with the margins of
 //! [`Budget::from_measured`]; `scripts/measure_budgets.py` regenerates the tables.
 //! Textured-light errors are per RGB channel of radiance-weighted visibility (DCS eq. 2), so
 //! they are larger in absolute terms.

@@ -39,7 +39,10 @@ impl Backprojection {
     /// depth `z`, through a kernel of `width` texels; `occludes(depth, ix, iy)` is the biased
     /// depth test of a texel. Returns the occluded part of the light (area and, for a textured
     /// light, radiance; overlaps may exceed the light) and the samples read.
-    #[allow(clippy::too_many_arguments)]
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "one occlusion test reads the map sample, the receiver and its kernel together"
+    )]
     pub fn occluded(
         &self,
         sm: &ShadowMap,

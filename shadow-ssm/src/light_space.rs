@@ -67,7 +67,10 @@ impl Contours {
 
     /// The occluded part of the light for receiver `r` whose conservative kernel is `w_k`
     /// texels and whose continuous level is `lambda`.
-    #[allow(clippy::too_many_arguments)]
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "one occlusion test reads the pyramid level, the receiver and its kernel together"
+    )]
     pub fn occluded(
         &self,
         pyramid: &MinMaxPyramid,

@@ -208,7 +208,6 @@ impl ShadowMapFilter {
     /// gives the depth `plane(ix, iy)` at each texel centre (receiver-plane depth bias: a tap
     /// occludes when its depth is in front of the receiver's plane there by more than `bias`,
     /// so wide kernels do not shadow a surface with itself).
-    #[allow(clippy::too_many_arguments)]
     fn shade(
         &self,
         cx: &Context,

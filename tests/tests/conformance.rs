@@ -15,14 +15,14 @@
 use std::sync::{Arc, OnceLock};
 
 use libtest_mimic::{Arguments, Failed, Trial};
+use shadow_conformance::closed_form::{masked, quad_over_plane_buffer};
+use shadow_conformance::conformance::{
+    GPU_TEST_RESOLUTION, Outcome, SceneContext, SuiteConfig, run_case,
+};
+use shadow_conformance::registry;
 use shadow_core::preset::Preset;
 use shadow_core::scenes::{BUILTIN_SCENES, builtin};
 use shadow_core::technique::{Processor, UnsupportedReason};
-use shadow_tests::closed_form::{masked, quad_over_plane_buffer};
-use shadow_tests::conformance::{
-    GPU_TEST_RESOLUTION, Outcome, SceneContext, SuiteConfig, run_case,
-};
-use shadow_tests::registry;
 
 /// A scene's context, built by the first case that needs it and shared by the others.
 struct LazyContext {

@@ -12,12 +12,12 @@ use clap::Args;
 use glam::Vec3;
 use serde::Serialize;
 use serde_json::json;
+use shadow_conformance::conformance::run_technique;
 use shadow_core::metrics::compare;
 use shadow_core::prelude::*;
 use shadow_core::procedural::{floor, uv_sphere};
 use shadow_core::scenes::{BUILTIN_SCENES, builtin};
 use shadow_ref::Reference;
-use shadow_tests::conformance::run_technique;
 
 use crate::common::{machine, progress, rays_per_second_per_thread, write_json};
 use crate::ensure_dir;
@@ -181,9 +181,9 @@ pub fn run(a: BenchArgs) -> Result<(), String> {
         }
     }
     for t in &a.techniques {
-        shadow_tests::preset(t)?;
+        shadow_conformance::preset(t)?;
     }
-    let presets: Vec<_> = shadow_tests::registry()
+    let presets: Vec<_> = shadow_conformance::registry()
         .into_iter()
         .filter(|p| a.techniques.is_empty() || a.techniques.iter().any(|t| t == p.name))
         .collect();

@@ -55,7 +55,7 @@ pub fn resolve_technique(
     samples: Option<u32>,
     seed: u64,
 ) -> Result<Box<dyn ShadowTechnique>, String> {
-    let p = shadow_tests::preset(name)?;
+    let p = shadow_conformance::preset(name)?;
     match samples {
         None => Ok((p.make)(seed)),
         Some(n) => match p.with_samples {

@@ -7,12 +7,12 @@ use std::path::PathBuf;
 
 use clap::Args;
 use serde_json::json;
-use shadow_core::image_io::{write_error_png, write_shaded_png, write_visibility_png};
-use shadow_core::scenes::{BUILTIN_SCENES, builtin};
-use shadow_tests::conformance::{
+use shadow_conformance::conformance::{
     BUDGET_RESOLUTION, Outcome, SceneContext, SuiteConfig, reference_curve, reference_time_at,
     run_case,
 };
+use shadow_core::image_io::{write_error_png, write_shaded_png, write_visibility_png};
+use shadow_core::scenes::{BUILTIN_SCENES, builtin};
 
 use crate::common::{machine, progress, write_json};
 use crate::ensure_dir;
@@ -49,9 +49,9 @@ pub struct ConformanceArgs {
 const CURVE: [u32; 6] = [1, 4, 16, 64, 256, 1024];
 
 pub fn run(a: ConformanceArgs) -> Result<(), String> {
-    let presets = shadow_tests::registry();
+    let presets = shadow_conformance::registry();
     for t in &a.techniques {
-        shadow_tests::preset(t)?;
+        shadow_conformance::preset(t)?;
     }
     for s in &a.scenes {
         if !BUILTIN_SCENES.contains(&s.as_str()) {

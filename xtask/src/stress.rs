@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use shadow_tests::stress::{input_cases, known_limitation, technique_cases};
+use shadow_conformance::stress::{input_cases, known_limitation, technique_cases};
 
 use crate::common::{machine, write_json};
 use crate::ensure_dir;
@@ -26,13 +26,13 @@ pub struct StressArgs {
 
 pub fn run(a: StressArgs) -> Result<(), String> {
     let mut results = input_cases();
-    let presets = shadow_tests::registry();
+    let presets = shadow_conformance::registry();
     for p in &presets {
         if a.techniques.is_empty() || a.techniques.iter().any(|t| t == p.name) {
             results.extend(technique_cases(p, a.width, a.height));
         }
     }
-    let known = |r: &shadow_tests::stress::StressResult| {
+    let known = |r: &shadow_conformance::stress::StressResult| {
         presets
             .iter()
             .find(|p| p.name == r.technique)

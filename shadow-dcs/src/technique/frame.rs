@@ -1,0 +1,532 @@
+//! The frame of one estimate (Algorithm 2 for one light): preparation per scene and light,
+//! the integration constants and counter width of every view sample, the squares of the wedge
+//! scan, and the estimate and direct illumination assembled from the per-pixel pass
+//! ([`super::pixel`]).
+
+use super::*;
+
+impl Dcs {
+    /// Everything per frame before the per-pixel pass.
+    pub(super) fn frame<'a>(
+        &self,
+        p: &Prepared,
+        view: &'a ViewSamples,
+        stats: &mut Stats,
+    ) -> Result<Frame<'a>, TechniqueError> {
+        let eye = view.eye().ok_or_else(|| {
+            TechniqueError::unsupported(
+                &self.name,
+                UnsupportedReason::View(
+                    "orthographic views: the shadow-volume step counts quads from an eye point"
+                        .into(),
+                ),
+            )
+        })?;
+        let n = view.len();
+        let (origins, horizon): (Vec<Vec3>, Vec<Horizon>) = (0..n)
+            .into_par_iter()
+            .map(|i| match view.get(i) {
+                Some(s) => {
+                    let o = p.offset.offset(s.position, s.geometric_normal);
+                    (o, Self::horizon(&p.shape, &s, o))
+                }
+                None => (Vec3::ZERO, Horizon::Below),
+            })
+            .unzip();
+        let active: Vec<bool> = horizon.par_iter().map(|h| *h != Horizon::Below).collect();
+        let c = p.shape.center;
+        let cd = c.as_dvec3();
+        let centred: Vec<Vec3> = origins
+            .par_iter()
+            .map(|o| (o.as_dvec3() - cd).as_vec3())
+            .collect();
+        let (constants, quads) = stats.time("shadow-volumes", || {
+            let eye_c = eye_constant(p.scene.as_ref(), p.units, eye, c);
+            integration_constants(
+                &p.edges,
+                &p.silhouettes,
+                c,
+                eye,
+                eye_c,
+                view.raster_view(),
+                &origins,
+                &centred,
+                &active,
+            )
+        });
+        stats.add("shadow-volume-quads", quads);
+        let max_constant = constants.par_iter().copied().max().unwrap_or(0).max(0) as u64;
+        let bits = self.forced_bits.unwrap_or_else(|| width_for(max_constant));
+        stats.gauge_max("max-integration-constant", max_constant);
+        stats.gauge_max("counter-bits", bits as u64);
+        stats.add("wedges", p.scan.len() as u64);
+        let planar_ok = match (&p.planar, self.covered) {
+            (Some(pl), CoveredSamples::Exact) => centred
+                .par_iter()
+                .zip(&active)
+                .map(|(x, a)| *a && x.dot(pl.normal).abs() > NEAR_PLANE * x.length())
+                .collect(),
+            _ => Vec::new(),
+        };
+        Ok(Frame {
+            origins,
+            centred,
+            horizon,
+            active,
+            constants,
+            planar_ok,
+            bits,
+            view,
+        })
+    }
+
+    /// Runs the per-pixel pass over the square `rect`: its wedge pairs (from the wedges its box
+    /// keeps, `wedges`), then every view sample, handed to `visit` with its class and the
+    /// scratch holding its visible samples and, with `values`, its samples' visibilities and
+    /// depth complexities.
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "the per-pixel pass hands its prepared data, frame, pixel, scratch and counters down the hot path"
+    )]
+    pub(super) fn run_square(
+        &self,
+        p: &Prepared,
+        f: &Frame,
+        wedges: &[u32],
+        rect: Rect,
+        values: bool,
+        counts: &mut Counts,
+        buffers: &mut SquareBuffers,
+        mut visit: impl FnMut(usize, &ViewSample, PixelClass, &Scratch),
+    ) {
+        let view = f.view;
+        let SquareBuffers {
+            pairs,
+            scan,
+            scratch,
+        } = buffers;
+        scratch.want_values = values;
+        square_pairs(&Self::scan_input(p, f), wedges, rect, pairs, scan);
+        counts.scan.add(&pairs.counts);
+        counts.pairs += pairs.len() as u64;
+        let w = view.width() as usize;
+        for (j, x, y) in pairs.pixels() {
+            let i = y as usize * w + x as usize;
+            let Some(s) = view.get_at(x, y) else { continue };
+            let (entries, tests) = pairs.of(j);
+            let class = self.pixel(p, f, i, &s, entries, tests, scratch, counts);
+            visit(i, &s, class, scratch);
+        }
+    }
+
+    /// What the wedge scan reads of a frame.
+    pub(super) fn scan_input<'a>(p: &'a Prepared, f: &'a Frame) -> ScanInput<'a> {
+        ScanInput {
+            edges: &p.edges,
+            wedges: &p.scan,
+            lanes: &p.scan_lanes,
+            c: p.shape.center.as_dvec3(),
+            width: f.view.width(),
+            origins: &f.origins,
+            centred: &f.centred,
+            active: &f.active,
+            slack: (FOLD_SLACK * p.extent) as f32,
+            planar: (!f.planar_ok.is_empty()).then_some((&p.centred_edges[..], &f.planar_ok[..])),
+        }
+    }
+
+    /// Runs `work` on every square of the view in parallel, with the wedges its box keeps (the
+    /// box hierarchy of [`crate::bins`]: blocks, then their squares). Returns each square's
+    /// result and the number of (block, wedge) pairs kept.
+    pub(super) fn squares<T: Send>(
+        &self,
+        p: &Prepared,
+        f: &Frame,
+        work: impl Fn(Rect, &[u32], &mut SquareBuffers) -> T + Sync + Send,
+    ) -> (Vec<(Rect, T)>, u64) {
+        let view = f.view;
+        let input = Self::scan_input(p, f);
+        let blocks = crate::bins::blocks(view.width(), view.height());
+        let levels = BlockWedges::new(&input, &blocks);
+        // Every block's square lists first, then all squares of the view as one parallel
+        // loop: a block boundary is no barrier, so a thread that runs out of work steals any
+        // square left, not only those of the block it is in.
+        let lists: Vec<(Vec<Vec<u32>>, usize)> = blocks
+            .par_iter()
+            .enumerate()
+            .map(|(bi, (_, squares))| levels.square_lists(&input, bi, squares))
+            .collect();
+        let kept = lists.iter().map(|(_, k)| *k as u64).sum();
+        let jobs: Vec<(Rect, &[u32])> = blocks
+            .iter()
+            .zip(&lists)
+            .flat_map(|((_, squares), (l, _))| {
+                squares.iter().copied().zip(l.iter().map(Vec::as_slice))
+            })
+            .collect();
+        // One square per job: a square's cost ranges from nothing to milliseconds (the
+        // penumbra gathers in a few of them), and rayon's own split of the list left one
+        // thread on a run of 128 costly squares while the other idled (on `bunny`, a thread
+        // busy 90 ms of the pass's 164 ms). The buffers go back to a pool after each square,
+        // since a job per square would otherwise start from empty buffers every time.
+        let pool = Mutex::new(Vec::<SquareBuffers>::new());
+        let out = jobs
+            .par_iter()
+            .with_max_len(1)
+            .map(|&(r, list)| {
+                let mut buffers = pool
+                    .lock()
+                    .ok()
+                    .and_then(|mut p| p.pop())
+                    .unwrap_or_default();
+                let done = work(r, list, &mut buffers);
+                if let Ok(mut p) = pool.lock() {
+                    p.push(buffers);
+                }
+                (r, done)
+            })
+            .collect();
+        (out, kept)
+    }
+
+    /// Direct illumination of every view sample by DCS eq. 6: the light samples' contributions
+    /// weighted by their binary visibility (saturated opacity sums with semi-opaque occluders).
+    ///
+    /// # Errors
+    /// `Unsupported` for orthographic views.
+    pub(super) fn direct(
+        &self,
+        p: &Prepared,
+        view: &ViewSamples,
+    ) -> Result<Vec<Vec3>, TechniqueError> {
+        let mut stats = Stats::default();
+        let f = self.frame(p, view, &mut stats)?;
+        let (parts, _) = self.squares(p, &f, |rect, block, buffers| {
+            let mut out = Vec::with_capacity(rect.len());
+            let mut counts = Counts::default();
+            let mut units = Vec::new();
+            let mut samples = Vec::new();
+            // Eq. 6 weighs every sample by its visibility.
+            self.run_square(
+                p,
+                &f,
+                block,
+                rect,
+                true,
+                &mut counts,
+                buffers,
+                |i, s, _, scratch| {
+                    let light = p.light.as_ref();
+                    let samples: &[LightSample] = if scratch.samples.is_empty() {
+                        self.sampler.unit_samples(s.pixel, &mut units);
+                        samples.clear();
+                        light.sample_into(&units, &mut samples);
+                        &samples
+                    } else {
+                        &scratch.samples
+                    };
+                    let albedo = p.scene.albedo(s.triangle as usize);
+                    let vis = &scratch.vis;
+                    out.push((i, pixel_direct(s, albedo, light, samples, |k| vis[k])));
+                },
+            );
+            out
+        });
+        let mut out = vec![Vec3::ZERO; view.len()];
+        for (i, d) in parts.into_iter().flat_map(|(_, v)| v) {
+            out[i] = d;
+        }
+        Ok(out)
+    }
+
+    /// Builds the edges, silhouettes, wedges and (section 7.3) tables for `scene` and `light`.
+    ///
+    /// # Errors
+    /// [`TechniqueError::Unsupported`] when the scene or light is outside the capabilities.
+    pub fn prepare_dcs(
+        &self,
+        scene: SceneRef,
+        light: Light,
+    ) -> Result<PreparedDcs, TechniqueError> {
+        self.capabilities()
+            .require(&self.name, scene.as_ref(), light.as_ref())?;
+        let mut stats = Stats::default();
+        let shape = LightShape::new(light.as_ref(), &self.name)?;
+        let (edges, units) = stats.time("edges", || scene_edges(scene.as_ref(), shape.center));
+        let sil = stats.time("silhouettes", || {
+            silhouettes(&edges, &shape, self.detection)
+        });
+        stats.add("edges", edges.len() as u64);
+        stats.add("silhouette-edges", sil.len() as u64);
+        let tables = match self.covered {
+            CoveredSamples::Discrete | CoveredSamples::Refined => {
+                Some(stats.time("discrete-tables", || {
+                    DiscreteTables::build(
+                        &self.sampler,
+                        light.as_ref(),
+                        &shape,
+                        self.covered == CoveredSamples::Refined,
+                        &self.name,
+                    )
+                })?)
+            }
+            CoveredSamples::Exact => None,
+        };
+        let extent = scene.bounds().union(light.bounds()).diagonal();
+        let polygon = shape.plane.as_ref().map(|pl| {
+            let c = shape.center.as_dvec3();
+            pl.polygon
+                .iter()
+                .map(|v| (v.as_dvec3() - c).as_vec3())
+                .collect()
+        });
+        let cd = shape.center.as_dvec3();
+        let centred_edges = sil
+            .iter()
+            .map(|&i| CentredEdge::new(&edges[i as usize], cd))
+            .collect();
+        let wedges = stats.time("wedges", || wedges(&edges, &sil, &shape));
+        let planar = shape.plane.as_ref().map(|pl| PlanarLight {
+            u: pl.u,
+            v: pl.v,
+            normal: pl.u.cross(pl.v),
+        });
+        let rect = match (light.geometry(), &shape.plane, light.is_textured()) {
+            (LightGeometry::Rectangle { half_u, half_v, .. }, Some(pl), false) => {
+                Some(RectMap::new(half_u, half_v, pl.u, pl.v))
+            }
+            _ => None,
+        };
+        let (scan, scan_lanes) = wedges
+            .par_iter()
+            .map(|w| {
+                let pe = shape.plane.as_ref().map(|pl| {
+                    let (u, v) = (pl.u.as_dvec3(), pl.v.as_dvec3());
+                    PlanarEdge::new(&edges[w.edge as usize], cd, u, v)
+                });
+                ScanWedge::new(w, pe)
+            })
+            .unzip();
+        let p = Prepared {
+            planar,
+            rect,
+            scan,
+            scan_lanes,
+            polygon,
+            centred_edges,
+            scene,
+            light,
+            shape,
+            edges,
+            silhouettes: sil,
+            units,
+            offset: RayOffset::for_extent(extent),
+            extent: extent as f64,
+            tables,
+        };
+        Ok(PreparedDcs {
+            config: self.clone(),
+            p,
+            stats,
+        })
+    }
+
+    /// The estimate of `view` on prepared data `p`, with `output` per sample.
+    pub(super) fn run(
+        &self,
+        p: &Prepared,
+        view: &ViewSamples,
+        output: PerSampleOutput,
+    ) -> Result<Estimate, TechniqueError> {
+        let mut stats = Stats::default();
+        let f = self.frame(p, view, &mut stats)?;
+        let n = self.sampler.count() as usize;
+        let words = n.div_ceil(64);
+        let w = view.width() as usize;
+        let textured = p.light.is_textured();
+        struct Row {
+            v: Vec<f32>,
+            rgb: Vec<Vec3>,
+            class: Vec<PixelClass>,
+            bits: Vec<u64>,
+            depth: Vec<u32>,
+            counts: Counts,
+        }
+        let (strips, block_wedges) = stats.time("depth-complexity", || {
+            self.squares(p, &f, |rect, block, buffers| {
+                let m = rect.len();
+                let rw = rect.width() as usize;
+                let mut r = Row {
+                    v: vec![0.0; m],
+                    rgb: vec![Vec3::ZERO; if textured { m } else { 0 }],
+                    class: vec![PixelClass::Background; m],
+                    bits: vec![
+                        0;
+                        if output == PerSampleOutput::Bits {
+                            m * words
+                        } else {
+                            0
+                        }
+                    ],
+                    depth: vec![
+                        0;
+                        if output == PerSampleOutput::Counters {
+                            m * n
+                        } else {
+                            0
+                        }
+                    ],
+                    counts: Counts::default(),
+                };
+                let mut counts = Counts::default();
+                let values = textured || output == PerSampleOutput::Counters || p.units != 1;
+                self.run_square(
+                    p,
+                    &f,
+                    block,
+                    rect,
+                    values,
+                    &mut counts,
+                    buffers,
+                    |i, _, class, scratch| {
+                        let x =
+                            (i / w - rect.rows.0 as usize) * rw + (i % w - rect.cols.0 as usize);
+                        r.class[x] = class;
+                        let vis = &scratch.vis;
+                        // Lit and umbra pixels (most of an image): every sample alike.
+                        let uniform = match class {
+                            PixelClass::Lit => Some(true),
+                            PixelClass::Umbra | PixelClass::Skipped => Some(false),
+                            _ => None,
+                        };
+                        if let (Some(lit), false, false) =
+                            (uniform, textured, output == PerSampleOutput::Counters)
+                        {
+                            r.v[x] = if lit { 1.0 } else { 0.0 };
+                            if lit && output == PerSampleOutput::Bits {
+                                for (k, word) in
+                                    r.bits[x * words..(x + 1) * words].iter_mut().enumerate()
+                                {
+                                    let left = n - k * 64;
+                                    *word = if left >= 64 {
+                                        u64::MAX
+                                    } else {
+                                        (1 << left) - 1
+                                    };
+                                }
+                            }
+                            return;
+                        }
+                        if !scratch.want_values {
+                            // Whole units, no texture, bits at most: the visible samples say all.
+                            let seen: u32 = scratch.visible.iter().map(|w| w.count_ones()).sum();
+                            r.v[x] = (f64::from(seen) / n as f64) as f32;
+                            if output == PerSampleOutput::Bits {
+                                r.bits[x * words..(x + 1) * words]
+                                    .copy_from_slice(&scratch.visible);
+                            }
+                            return;
+                        }
+                        let sum: f64 = vis.iter().map(|&v| v as f64).sum();
+                        r.v[x] = (sum / n as f64) as f32;
+                        if textured {
+                            let acc = scratch
+                                .radiances
+                                .iter()
+                                .zip(vis)
+                                .fold(Vec3::ZERO, |a, (l, v)| a + *l * *v);
+                            r.rgb[x] = acc / n as f32;
+                        }
+                        match output {
+                            PerSampleOutput::Bits => {
+                                for (k, &v) in vis.iter().enumerate() {
+                                    if v == 1.0 {
+                                        r.bits[x * words + k / 64] |= 1 << (k % 64);
+                                    }
+                                }
+                            }
+                            PerSampleOutput::Counters => {
+                                for (k, &d) in scratch.depth.iter().enumerate() {
+                                    r.depth[x * n + k] = d.min(u32::MAX as u64) as u32;
+                                }
+                            }
+                            PerSampleOutput::None => {}
+                        }
+                    },
+                );
+                r.counts = counts;
+                r
+            })
+        });
+        let mut vis = if textured {
+            VisibilityImage::rgb_buffer(view)
+        } else {
+            VisibilityImage::scalar(view)
+        };
+        let mut classes = vec![PixelClass::Background; view.len()];
+        let mut counts = Counts::default();
+        let mut bits = vec![
+            0u64;
+            if output == PerSampleOutput::Bits {
+                view.len() * words
+            } else {
+                0
+            }
+        ];
+        let mut depth = vec![
+            0u32;
+            if output == PerSampleOutput::Counters {
+                view.len() * n
+            } else {
+                0
+            }
+        ];
+        // Each square's rows into the image, bands of squares in parallel (a serial copy
+        // was 5 ms of a 160 ms frame on two threads).
+        if textured {
+            scatter_squares(vis.rgbs_mut(), 1, w, &strips, |r| &r.rgb);
+        } else {
+            scatter_squares(vis.scalars_mut(), 1, w, &strips, |r| &r.v);
+        }
+        scatter_squares(&mut classes, 1, w, &strips, |r| &r.class);
+        scatter_squares(&mut bits, words, w, &strips, |r| &r.bits);
+        scatter_squares(&mut depth, n, w, &strips, |r| &r.depth);
+        for (_, r) in &strips {
+            counts.add(&r.counts);
+        }
+        vis.set_classes(classes)?;
+        match output {
+            PerSampleOutput::Bits => vis.set_per_sample(PerSampleVisibility::Bits {
+                samples: n as u32,
+                words: bits,
+            })?,
+            PerSampleOutput::Counters => vis.set_per_sample(PerSampleVisibility::Counters {
+                samples: n as u32,
+                counts: depth,
+            })?,
+            PerSampleOutput::None => {}
+        }
+        stats.add("pixels-facing-away", counts.facing_away);
+        stats.add("pixels-constant-only", counts.constant_only);
+        stats.add("pixels-per-sample", counts.per_sample);
+        stats.add("edge-tests", counts.edge_tests);
+        stats.add("covered-updates", counts.covered_updates);
+        stats.add("counter-escalations", counts.escalations);
+        stats.add("plain-counter-fallbacks", counts.plain_fallback);
+        stats.add("negative-depth-complexity", counts.negative);
+        stats.add("edge-ties", counts.ties + counts.scan.ties);
+        stats.add("wedge-pixels-scanned", counts.scan.scanned);
+        stats.add("wedge-exact-weights", counts.scan.exact_weights);
+        stats.add("bin-block-wedges", block_wedges);
+        stats.add("bin-square-wedges", counts.scan.square_wedges);
+        stats.add("bin-tile-wedges", counts.scan.tile_wedges);
+        stats.add("wedge-pairs", counts.pairs);
+        stats.add("wedge-pairs-off-light", counts.off_light);
+        stats.add("wedge-pairs-empty-sector", counts.sector_empty);
+        stats.add("refined-line-cells", counts.line_cells);
+        stats.add("pixels-shared-sample-sets", counts.shared_set_pixels);
+        stats.add("shared-sample-sets-built", counts.shared_sets_built);
+        vis.validate()?;
+        Ok(Estimate::new(vis, stats))
+    }
+}
