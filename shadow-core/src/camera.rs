@@ -83,6 +83,11 @@ impl Camera {
         })
     }
 
+    /// The near clipping distance.
+    pub fn near(&self) -> f32 {
+        self.znear
+    }
+
     /// Sets the near clipping distance (default 1e-4 m).
     ///
     /// # Errors

@@ -270,6 +270,8 @@ fn lights_camera_and_opacities_load_as_written() {
     assert!((cam.position() - Vec3::new(0.0, 2.0, 6.0)).length() < 1e-5);
     assert!((cam.forward() - Vec3::NEG_Z).length() < 1e-5);
     assert!((cam.yfov() - 0.8).abs() < 1e-6);
+    // The file's near plane (issue 51, item 10: it was ignored for a fixed 1e-4).
+    assert_eq!(cam.near(), 0.01);
     assert_eq!(setup.aspect, Some(1.5));
     // Opacities: floor opaque, BLEND glass 0.4, MASK ignores alpha.
     let s = &setup.scene;
@@ -575,4 +577,39 @@ fn a_primitive_naming_a_missing_accessor_is_an_error() {
     let mut doc = test_document();
     doc["meshes"][0]["primitives"][0]["material"] = json!(77);
     assert!(matches!(load(&doc), Err(LoadError::Missing(m)) if m.contains("77")));
+}
+
+/// Issue 51, item 17: a relative buffer URI that climbs out of the scene's folder
+/// (`../../etc/...`) is refused, even when the file it names exists.
+#[test]
+fn uris_may_not_leave_the_scenes_folder() {
+    let root = std::env::temp_dir().join(format!("shadow-core-uri-{}", std::process::id()));
+    let dir = root.join("scene");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut doc = test_document();
+    let uri = doc["buffers"][0]["uri"].as_str().unwrap().to_string();
+    let bin = base64::engine::general_purpose::STANDARD
+        .decode(uri.split_once(";base64,").unwrap().1)
+        .unwrap();
+    std::fs::write(root.join("outside.bin"), &bin).unwrap();
+    for climbing in [
+        "../outside.bin",
+        "./../outside.bin",
+        "sub/../../outside.bin",
+    ] {
+        doc["buffers"][0]["uri"] = json!(climbing);
+        std::fs::write(dir.join("scene.gltf"), doc.to_string()).unwrap();
+        match load_gltf(&dir.join("scene.gltf"), &LoadLimits::default()) {
+            Err(LoadError::Unsupported { reason, .. }) => {
+                assert!(reason.contains(".."), "{reason}")
+            }
+            other => panic!("{climbing}: {other:?}"),
+        }
+    }
+    // Beside the file is fine.
+    std::fs::write(dir.join("inside.bin"), &bin).unwrap();
+    doc["buffers"][0]["uri"] = json!("./inside.bin");
+    std::fs::write(dir.join("scene.gltf"), doc.to_string()).unwrap();
+    assert!(load_gltf(&dir.join("scene.gltf"), &LoadLimits::default()).is_ok());
+    std::fs::remove_dir_all(&root).ok();
 }

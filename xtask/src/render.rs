@@ -46,6 +46,18 @@ pub struct RenderArgs {
     out: PathBuf,
 }
 
+/// Every file a render may write; each run removes them first.
+const OUTPUTS: [&str; 8] = [
+    "position.exr",
+    "normal.exr",
+    "stats.json",
+    "visibility.exr",
+    "visibility.png",
+    "shaded.png",
+    "direct.exr",
+    "direct.png",
+];
+
 pub fn run(a: RenderArgs) -> Result<(), String> {
     let setup = resolve_scene(&a.scene)?;
     let technique = match &a.technique {
@@ -60,12 +72,26 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         _ => (a.width * 3 / 4).max(1),
     });
     ensure_dir(&a.out)?;
+    // A failed run must not leave an older run's images beside its error.
+    for name in OUTPUTS {
+        let f = a.out.join(name);
+        if f.exists() {
+            std::fs::remove_file(&f).map_err(|e| format!("removing {}: {e}", f.display()))?;
+        }
+    }
     let pb = progress(if technique.is_some() { 4 } else { 2 }, "view samples");
     let camera = setup.camera_or_default();
     let t0 = Instant::now();
     let view = ViewSamples::render(setup.scene.as_ref(), &camera, a.width, height)
         .map_err(|e| e.to_string())?;
     let view_seconds = t0.elapsed().as_secs_f64();
+    if view.valid_count() == 0 {
+        return Err(format!(
+            "the camera sees no surface of `{}` at {}x{height} (is the scene in front of the \
+             camera and beyond its near plane?)",
+            setup.name, a.width
+        ));
+    }
     pb.inc(1);
     write_position_exr(&a.out.join("position.exr"), &view).map_err(|e| e.to_string())?;
     write_normal_exr(&a.out.join("normal.exr"), &view).map_err(|e| e.to_string())?;

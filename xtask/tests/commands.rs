@@ -214,3 +214,91 @@ fn direct_illumination_comes_from_the_chosen_sample_based_technique() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("light samples"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Issue 51, item 13: a failed run left an older run's `visibility.exr` and `stats.json` in its
+/// output folder, as if it had written them; a run removes what it would replace first.
+#[test]
+fn a_failed_render_leaves_no_older_outputs_behind() {
+    let dir = temp_dir("stale");
+    let d = dir.to_str().unwrap();
+    let ok = xtask(&[
+        "render",
+        "--scene",
+        "quad-over-plane",
+        "--technique",
+        "pcss",
+        "--width",
+        "16",
+        "--out",
+        d,
+    ]);
+    assert!(ok.status.success());
+    assert!(dir.join("visibility.exr").is_file() && dir.join("stats.json").is_file());
+    // The same technique cannot shade direct light: the run fails after its view samples.
+    let failed = xtask(&[
+        "render",
+        "--scene",
+        "quad-over-plane",
+        "--technique",
+        "pcss",
+        "--direct",
+        "--width",
+        "16",
+        "--out",
+        d,
+    ]);
+    assert!(!failed.status.success());
+    for f in [
+        "visibility.exr",
+        "visibility.png",
+        "shaded.png",
+        "stats.json",
+    ] {
+        assert!(!dir.join(f).exists(), "{f} left from the older run");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Issue 51, item 10: a view that sees no surface rendered nothing and exited 0; it is an
+/// error that says so.
+#[test]
+fn a_view_that_sees_no_surface_is_an_error() {
+    use base64::Engine;
+    let dir = temp_dir("no-surface");
+    std::fs::create_dir_all(&dir).unwrap();
+    // One triangle in front of the origin (toward -Z) and a camera at the origin looking +Z.
+    let mut bytes = Vec::new();
+    for v in [[-1.0f32, -1.0, -5.0], [1.0, -1.0, -5.0], [0.0, 1.0, -5.0]] {
+        for c in v {
+            bytes.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    let data = base64::engine::general_purpose::STANDARD.encode(&bytes);
+    let doc = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "buffers": [{"byteLength": 36, "uri": format!("data:application/octet-stream;base64,{data}")}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [-1.0, -1.0, -5.0], "max": [1.0, 1.0, -5.0]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.01}}],
+        "nodes": [{"mesh": 0}, {"camera": 0, "rotation": [0.0, 1.0, 0.0, 0.0]}],
+        "scenes": [{"nodes": [0, 1]}],
+        "scene": 0
+    });
+    let file = dir.join("away.gltf");
+    std::fs::write(&file, doc.to_string()).unwrap();
+    let out = xtask(&[
+        "render",
+        "--scene",
+        file.to_str().unwrap(),
+        "--width",
+        "16",
+        "--out",
+        dir.join("out").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(err.contains("sees no surface"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

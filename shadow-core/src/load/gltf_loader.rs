@@ -89,10 +89,12 @@ pub fn load_gltf_slice(
         {
             match cam.projection() {
                 gltf::camera::Projection::Perspective(p) => {
-                    camera = Some(Camera::from_world_transform(
-                        Affine3A::from_mat4(world),
-                        p.yfov(),
-                    )?);
+                    // The file's near plane, so that a scene modelled at a small scale keeps
+                    // its geometry in front of it.
+                    camera = Some(
+                        Camera::from_world_transform(Affine3A::from_mat4(world), p.yfov())?
+                            .with_near(p.znear())?,
+                    );
                     aspect = p.aspect_ratio();
                 }
                 gltf::camera::Projection::Orthographic(_) => warnings.push(format!(
@@ -268,6 +270,18 @@ fn resolve(base: Option<&Path>, uri: &str) -> Result<PathBuf, LoadError> {
         return Err(LoadError::Unsupported {
             mesh: uri,
             reason: "only relative file URIs and data URIs are supported".into(),
+        });
+    }
+    // A file may name data beside it or below it, never outside its own folder.
+    if Path::new(&uri).components().any(|c| {
+        !matches!(
+            c,
+            std::path::Component::Normal(_) | std::path::Component::CurDir
+        )
+    }) {
+        return Err(LoadError::Unsupported {
+            mesh: uri,
+            reason: "a URI may not leave the scene's folder (`..`)".into(),
         });
     }
     Ok(base.join(uri))
