@@ -40,7 +40,45 @@ enum Command {
     Stress(stress::StressArgs),
 }
 
+/// Marks a process that [`quiet_headless_vulkan`] started, so it never starts another.
+const RESPAWNED: &str = "SHADOW_XTASK_RUNTIME_DIR_SET";
+
+/// On a headless machine without `XDG_RUNTIME_DIR`, the Vulkan loader's window-system
+/// platforms print `error: XDG_RUNTIME_DIR is invalid or not set` on every successful GPU run,
+/// which a user reads as a failure. Setting the variable in this process would need `unsafe`
+/// (`std::env::set_var`), so the command runs once more as a child with a private runtime
+/// directory and hands back its exit code. `None` when nothing needs doing (the variable is a
+/// directory, or this is the child).
+fn quiet_headless_vulkan() -> Option<ExitCode> {
+    let set =
+        std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| std::path::Path::new(&d).is_dir());
+    if set || std::env::var_os(RESPAWNED).is_some() {
+        return None;
+    }
+    let dir = std::env::temp_dir().join(format!("shadow-xtask-runtime-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).ok()?;
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700)).ok()?;
+    }
+    let exe = std::env::current_exe().ok()?;
+    // Not started: run here, with the note. Started: its exit code, whatever it is.
+    let status = std::process::Command::new(exe)
+        .args(std::env::args_os().skip(1))
+        .env("XDG_RUNTIME_DIR", &dir)
+        .env(RESPAWNED, "1")
+        .status()
+        .ok();
+    std::fs::remove_dir_all(&dir).ok();
+    let code = status?.code().unwrap_or(1);
+    Some(ExitCode::from(u8::try_from(code).unwrap_or(1)))
+}
+
 fn main() -> ExitCode {
+    if let Some(code) = quiet_headless_vulkan() {
+        return code;
+    }
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Scenes => common::list_scenes(),
