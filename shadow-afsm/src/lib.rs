@@ -49,6 +49,7 @@
 pub mod budgets;
 pub mod frame;
 pub mod influence;
+mod inputs;
 pub mod lut;
 pub mod params;
 pub mod passes;
