@@ -33,6 +33,10 @@ pub struct RenderArgs {
     /// Image height (default: from the camera's aspect ratio, else 3/4 of the width).
     #[arg(long)]
     height: Option<u32>,
+    /// Which of the scene's lights to shadow (0-based, in file order); a scene with several
+    /// lights needs it.
+    #[arg(long)]
+    light: Option<usize>,
     /// Seed of the technique's sampling.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -67,6 +71,8 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
     if a.technique.is_none() && a.samples.is_some() && !a.direct {
         return Err("--samples needs --technique or --direct".into());
     }
+    let light_index = choose_light(&setup, a.light)?;
+    let light = setup.lights[light_index].clone();
     let height = a.height.unwrap_or_else(|| match setup.aspect {
         Some(r) if r > 0.0 && r.is_finite() => ((a.width as f32 / r).round() as u32).max(1),
         _ => (a.width * 3 / 4).max(1),
@@ -99,7 +105,8 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
     let mut stats = json!({
         "scene": setup.name,
         "triangles": setup.scene.triangle_count(),
-        "light": format!("{:?}", setup.lights[0].kind()),
+        "light": format!("{:?}", light.kind()),
+        "light_index": light_index,
         "width": a.width,
         "height": height,
         "valid_pixels": view.valid_count(),
@@ -112,7 +119,7 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
     if let Some(t) = technique.as_ref() {
         pb.set_message(format!("{}: prepare", t.name()));
         let prepared = t
-            .prepare(setup.scene.clone(), setup.lights[0].clone())
+            .prepare(setup.scene.clone(), light.clone())
             .map_err(|e| e.to_string())?;
         pb.inc(1);
         pb.set_message(format!("{}: estimate", t.name()));
@@ -140,7 +147,7 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
             &a.out.join("shaded.png"),
             setup.scene.as_ref(),
             &view,
-            setup.lights[0].as_ref(),
+            light.as_ref(),
             &est.visibility,
         )
         .map_err(|e| e.to_string())?;
@@ -161,7 +168,7 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
             .map_err(|e| e.to_string())?;
         let t0 = Instant::now();
         let prepared = r
-            .prepare_reference(setup.scene.clone(), setup.lights[0].clone())
+            .prepare_reference(setup.scene.clone(), light.clone())
             .map_err(|e| e.to_string())?;
         let direct = prepared.direct_illumination(&view);
         write_direct(&a.out, &view, &direct)?;
@@ -191,4 +198,33 @@ fn write_direct(
 ) -> Result<(), String> {
     write_rgb_exr(&out.join("direct.exr"), view, direct).map_err(|e| e.to_string())?;
     write_radiance_png(&out.join("direct.png"), view, direct).map_err(|e| e.to_string())
+}
+
+/// The light to shadow: `chosen`, or the only one; a scene with several lights and no choice is
+/// an error that lists them, never a silent pick of the first.
+fn choose_light(setup: &SceneSetup, chosen: Option<usize>) -> Result<usize, String> {
+    let n = setup.lights.len();
+    let list = || {
+        setup
+            .lights
+            .iter()
+            .enumerate()
+            .map(|(i, l)| format!("{i}: {:?} at {:.3}", l.kind(), l.center()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    match chosen {
+        Some(k) if k < n => Ok(k),
+        Some(k) => Err(format!(
+            "--light {k}: `{}` has {n} light(s) ({})",
+            setup.name,
+            list()
+        )),
+        None if n == 1 => Ok(0),
+        None => Err(format!(
+            "`{}` has {n} lights ({}); choose one with --light K",
+            setup.name,
+            list()
+        )),
+    }
 }

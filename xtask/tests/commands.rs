@@ -380,3 +380,104 @@ fn a_successful_gpu_render_prints_no_error_line() {
     assert!(!err.contains("error:"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// A glTF file of non-indexed triangle meshes (positions only), each emissive when it has an
+/// emission: `(positions, emission)`.
+fn gltf_of(meshes: &[(Vec<[f32; 3]>, Option<[f32; 3]>)]) -> String {
+    use base64::Engine;
+    let mut bytes = Vec::new();
+    let (mut views, mut accessors, mut mesh_list, mut materials, mut nodes) =
+        (vec![], vec![], vec![], vec![], vec![]);
+    for (k, (pos, emission)) in meshes.iter().enumerate() {
+        let offset = bytes.len();
+        for v in pos {
+            for c in v {
+                bytes.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        let lo = (0..3).map(|i| pos.iter().map(|v| v[i]).fold(f32::INFINITY, f32::min));
+        let hi = (0..3).map(|i| pos.iter().map(|v| v[i]).fold(f32::NEG_INFINITY, f32::max));
+        views.push(
+            serde_json::json!({"buffer": 0, "byteOffset": offset, "byteLength": pos.len() * 12}),
+        );
+        accessors.push(
+            serde_json::json!({"bufferView": k, "componentType": 5126, "count": pos.len(),
+            "type": "VEC3", "min": lo.collect::<Vec<_>>(), "max": hi.collect::<Vec<_>>()}),
+        );
+        let material = match emission {
+            Some(e) => serde_json::json!({"emissiveFactor": e}),
+            None => serde_json::json!({}),
+        };
+        materials.push(material);
+        mesh_list.push(
+            serde_json::json!({"primitives": [{"attributes": {"POSITION": k}, "material": k}]}),
+        );
+        nodes.push(serde_json::json!({"mesh": k}));
+    }
+    let data = base64::engine::general_purpose::STANDARD.encode(&bytes);
+    serde_json::json!({
+        "asset": {"version": "2.0"},
+        "buffers": [{"byteLength": bytes.len(), "uri": format!("data:application/octet-stream;base64,{data}")}],
+        "bufferViews": views, "accessors": accessors, "meshes": mesh_list,
+        "materials": materials, "nodes": nodes,
+        "scenes": [{"nodes": (0..meshes.len()).collect::<Vec<_>>()}], "scene": 0
+    })
+    .to_string()
+}
+
+/// A square at height `y` of half side `h`, facing `down` or up, as two triangles.
+fn square_at(y: f32, h: f32, x: f32, down: bool) -> Vec<[f32; 3]> {
+    let (a, b, c, d) = ([x - h, y, -h], [x + h, y, -h], [x + h, y, h], [x - h, y, h]);
+    if down {
+        vec![a, b, c, a, c, d]
+    } else {
+        vec![a, c, b, a, d, c]
+    }
+}
+
+/// Issue 51, item 9: a second emissive mesh was ignored without a word; a scene with several
+/// lights is refused with a list of them unless `--light K` picks one.
+#[test]
+fn a_scene_with_several_lights_needs_a_choice() {
+    let dir = temp_dir("two-lights");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("two.gltf");
+    let gltf = gltf_of(&[
+        (square_at(0.0, 3.0, 0.0, false), None),
+        (square_at(2.0, 0.3, -1.0, true), Some([1.0, 1.0, 1.0])),
+        (square_at(2.0, 0.3, 1.0, true), Some([1.0, 1.0, 1.0])),
+    ]);
+    std::fs::write(&file, gltf).unwrap();
+    let out_dir = dir.join("out");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            "--scene",
+            file.to_str().unwrap(),
+            "--technique",
+            "ref-16",
+            "--width",
+            "16",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        xtask(&args)
+    };
+    let out = run(&[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains("2 lights") && err.contains("--light"), "{err}");
+    let out = run(&["--light", "1"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("stats.json")).unwrap())
+            .unwrap();
+    assert_eq!(stats["light_index"], 1);
+    assert!(!run(&["--light", "2"]).status.success());
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -121,10 +121,8 @@ fn one_word_table(prefix: &mut [u64], buckets: &[u32]) {
 /// them overwritten) of the samples in `buckets` (at most `64 W`, each below [`BUCKETS`]),
 /// through `hits` (at least `BUCKETS W` words, zero on entry and on return): each sample's bit
 /// set in its bucket's row of `hits`, the running OR of those rows written to `prefix`, then
-/// the rows of `hits` set cleared again. Neither table is zeroed whole, and the rows are fixed
-/// arrays (no index checks). At 256 samples on `bunny` the index took 685 M instructions with
-/// a zeroed table of rows of any length (246 M of them a `memset` of 8 KB per pixel, which
-/// callgrind counts byte by byte), and takes 234 M this way.
+/// the rows of `hits` set cleared again. Neither table is zeroed whole (a pixel touches few of
+/// its rows), and the rows are fixed arrays (no index checks).
 fn spread_table<const W: usize>(prefix: &mut [u64], hits: &mut [u64], buckets: &[u32]) {
     let (rows, _) = prefix.as_chunks_mut::<W>();
     let table: &mut [[u64; W]; BUCKETS + 1] = rows

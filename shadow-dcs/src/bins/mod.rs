@@ -15,8 +15,8 @@
 //! * **View samples** of a tile ([`crate::lanes`]): a surviving wedge's fold planes, bounding
 //!   planes and weight `k_e(p)` on every view sample at once; each view sample inside the
 //!   planes with a non-zero weight makes a (pixel, edge) pair. Only the bounding planes that
-//!   may cut the tile's box are evaluated on its view samples ([`ScanWedge::cut_planes`]): on
-//!   `bunny` that cut `dcs-64` from 1982 M to 1918 M instructions.
+//!   may cut the tile's box are evaluated on its view samples ([`ScanWedge::cut_planes`]): a
+//!   plane with the whole box on its positive side holds every view sample in it.
 //!
 //! A box keeps a wedge when none of the wedge's bounding planes ([`crate::wedges::wedge_planes`])
 //! has the whole box on its negative side, and the edge may be a silhouette from some point of
@@ -48,8 +48,9 @@ pub(crate) use boxes::*;
 pub(crate) use hierarchy::*;
 pub(crate) use squares::*;
 
-/// Side of a block, in pixels (a multiple of [`SQUARE`]). 128 rather than 64 since the box
-/// tests got cheaper (`bunny` `dcs-64`: 2176 M -> 2158 M instructions; 32: 2459 M).
+/// Side of a block, in pixels (a multiple of [`SQUARE`]): large enough that the top level
+/// tests few boxes per wedge, small enough that its box stays tight (the sizes tried are in
+/// `docs/history/`).
 pub(crate) const BLOCK: u32 = 128;
 
 /// Side of a square, in pixels (a multiple of [`TILE_W`] and [`TILE_H`]).
@@ -59,10 +60,8 @@ pub(crate) const SQUARE: u32 = 16;
 /// bounding planes bounds it). Eight fill two groups of four ([`PlaneGroup`]). The built-in
 /// scenes' wedges have 4 to 9 planes (`bunny`: 2,410 with 4, 25,620 with 6, 3 with 8, 2 with
 /// 9; `quad-over-plane` and `overlapping-occluders` 8 or 9); with 8 rather than 10 the tile
-/// candidates, pairs and covered updates are the same on every built-in scene, and a wedge
-/// took 448 bytes instead of 512 while it was one record (`bunny` `dcs-64`: 1784 M -> 1770 M
-/// instructions, simulated last-level misses 2,516 k -> 2,207 k, wall time 5% lower); its
-/// box-test record ([`ScanWedge`]) now takes 192.
+/// candidates, pairs and covered updates are the same on every built-in scene, and the
+/// box-test record ([`ScanWedge`]) stays at 192 bytes.
 const BOX_PLANES: usize = 8;
 
 /// Relative padding of a box, far above the rounding of its centre and of a plane evaluated there.
@@ -87,16 +86,11 @@ const OPEN: BoxPlane = Vec4::new(0.0, 0.0, 0.0, 1.0);
 /// [`WedgeLanes`].
 ///
 /// Laid out in declaration order (`repr(C)`) on cache-line boundaries: the count, the fold
-/// planes, then the groups of bounding planes, up to eight planes in three lines (192 bytes).
-/// Left to the compiler, the fields were reordered (the tile data first, the count after the
-/// weight), and a box test touched five lines of 656 bytes; in declaration order `bunny`'s
-/// simulated last-level misses fell by 10% (3,029 k to 2,729 k), with no change in wall time
-/// measured. The bounding planes are kept once, four to a group in structure-of-arrays form,
-/// which both the box tests (one plane at a time) and [`ScanWedge::cut_planes`] (a group at a
-/// time) read. With a second copy in plane-by-plane form a wedge took 704 bytes; one copy took
-/// it to 512 and `bunny` `dcs-64` from 0.138 s to 0.118 s on two threads (`scripts/dcs_ab.sh`,
-/// 8 rounds; 0.262 s to 0.219 s on one), for the same instructions (1786 M -> 1784 M) and 4%
-/// fewer simulated L1 misses: smaller records are what a square's wedges keep in the caches.
+/// planes, then the groups of bounding planes, up to eight planes in three lines (192 bytes),
+/// in declaration order (`repr(C)`) so that a box test touches only those lines. The bounding
+/// planes are kept once, four to a group in structure-of-arrays form, which both the box tests
+/// (one plane at a time) and [`ScanWedge::cut_planes`] (a group at a time) read: small records
+/// are what keeps a square's wedges in the caches.
 #[derive(Debug, Clone, Copy)]
 #[repr(C, align(64))]
 pub(crate) struct ScanWedge {
@@ -114,9 +108,7 @@ pub(crate) struct ScanWedge {
 /// What the view samples' pass reads of a wedge besides its [`ScanWedge`]: its weight from
 /// plane signs and its edge prepared for the light-plane test (256 bytes). Kept apart from the
 /// box-test data, so that the box tests of every level, which most wedges do not pass, read
-/// densely packed 192-byte records rather than 448-byte ones: `bunny` `dcs-64` 1758 M -> 1763 M
-/// instructions, and in wall time 0.1237 s -> 0.1208 s on two threads (8 A/B rounds), 0.236 s
-/// -> 0.225 s on one (mean of 8 alternating runs).
+/// densely packed 192-byte records rather than 448-byte ones.
 #[derive(Debug, Clone, Copy)]
 #[repr(C, align(64))]
 pub(crate) struct WedgeLanes {

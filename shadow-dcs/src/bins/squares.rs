@@ -279,10 +279,8 @@ pub(crate) struct ScanInput<'a> {
 /// each tile it keeps (fold planes, bounding planes, then the weight, exact where the
 /// single-precision signs are uncertain), with the light-plane test set up while the wedge is
 /// at hand. Each wedge's data is read once per square: tile by tile, with a list of wedges per
-/// tile, a wedge came back once per tile it met, after the other wedges had evicted it. On
-/// `bunny` (`scripts/dcs_instructions.sh --cache bunny dcs-64`) wedge by wedge took the
-/// simulated L1 data misses from 10.27 M to 9.21 M and `dcs-64` from 0.158 s to 0.146 s on two
-/// threads, for 2% more instructions (1746 M -> 1786 M).
+/// tile, a wedge came back once per tile it met, after the other wedges had evicted it; wedge
+/// by wedge trades a few instructions for fewer cache misses.
 pub(crate) fn square_pairs(
     input: &ScanInput,
     wedges: &[u32],
