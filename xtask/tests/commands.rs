@@ -381,13 +381,19 @@ fn a_successful_gpu_render_prints_no_error_line() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// A mesh for [`gltf_of`]: its positions (non-indexed triangles) and its emission, if any.
+type TestMesh = (Vec<[f32; 3]>, Option<[f32; 3]>);
+
 /// A glTF file of non-indexed triangle meshes (positions only), each emissive when it has an
-/// emission: `(positions, emission)`.
-fn gltf_of(meshes: &[(Vec<[f32; 3]>, Option<[f32; 3]>)]) -> String {
+/// emission.
+fn gltf_of(meshes: &[TestMesh]) -> String {
     use base64::Engine;
     let mut bytes = Vec::new();
-    let (mut views, mut accessors, mut mesh_list, mut materials, mut nodes) =
-        (vec![], vec![], vec![], vec![], vec![]);
+    let mut views = Vec::new();
+    let mut accessors = Vec::new();
+    let mut mesh_list = Vec::new();
+    let mut materials = Vec::new();
+    let mut nodes = Vec::new();
     for (k, (pos, emission)) in meshes.iter().enumerate() {
         let offset = bytes.len();
         for v in pos {
