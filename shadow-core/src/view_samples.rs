@@ -13,6 +13,11 @@ use crate::camera::Camera;
 use crate::raster::{NO_TRIANGLE, RasterError, RasterView, rasterize};
 use crate::scene::Scene;
 
+
+/// The largest view, in pixels (8192 x 4096): view samples cost about 64 bytes a pixel (2 GiB
+/// here), a technique's outputs more (per-sample visibility: `N / 8` bytes a pixel), so a larger
+/// request is refused before anything is allocated rather than exhausting memory.
+pub const MAX_VIEW_PIXELS: u64 = 1 << 25;
 /// The G-buffer of one camera view.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ViewSamples {
@@ -64,6 +69,14 @@ impl ViewSamples {
     /// # Errors
     /// [`RasterError`] for an invalid view.
     pub fn render_view(scene: &dyn Scene, view: &RasterView) -> Result<Self, RasterError> {
+        let pixels = u64::from(view.width) * u64::from(view.height);
+        if pixels > MAX_VIEW_PIXELS {
+            return Err(RasterError::TooManyPixels {
+                width: view.width,
+                height: view.height,
+                limit: MAX_VIEW_PIXELS,
+            });
+        }
         let frags = rasterize(scene.positions(), scene.triangles(), view, 1)?;
         let (w, h) = (view.width, view.height);
         let world_from_view = view.view_from_world.inverse();

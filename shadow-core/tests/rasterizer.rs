@@ -333,3 +333,22 @@ fn covered_pixels_equal_the_rasterizer_coverage() {
         }
     }
 }
+
+/// Issue 51, item 14: 16384x16384 was accepted and grew to 15.7 GB before it was killed; a
+/// view above `MAX_VIEW_PIXELS` is refused at once with the limit, and one at the limit's side
+/// lengths is accepted by the check.
+#[test]
+fn views_above_the_pixel_cap_are_refused_before_allocating() {
+    use shadow_core::raster::RasterError;
+    use shadow_core::view_samples::MAX_VIEW_PIXELS;
+    let setup = shadow_core::scenes::builtin("quad-over-plane").unwrap();
+    let camera = setup.camera_or_default();
+    let t0 = std::time::Instant::now();
+    match ViewSamples::render(setup.scene.as_ref(), &camera, 16384, 16384) {
+        Err(RasterError::TooManyPixels { limit, .. }) => assert_eq!(limit, MAX_VIEW_PIXELS),
+        other => panic!("{:?}", other.map(|v| v.len())),
+    }
+    assert!(t0.elapsed().as_secs_f64() < 1.0, "refused without work");
+    let e = ViewSamples::render(setup.scene.as_ref(), &camera, u32::MAX, 2).unwrap_err();
+    assert!(e.to_string().contains("largest supported view"), "{e}");
+}

@@ -89,6 +89,20 @@ pub enum RasterError {
         /// Layers.
         layers: u32,
     },
+    /// The image holds more pixels than view samples may (see
+    /// [`crate::view_samples::MAX_VIEW_PIXELS`] for the memory each costs).
+    #[error(
+        "image size {width}x{height} is above the largest supported view of {limit} pixels \
+         (view samples take about 64 bytes a pixel, techniques' outputs more)"
+    )]
+    TooManyPixels {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+        /// The limit.
+        limit: u64,
+    },
     /// The projection has non-finite or empty extents.
     #[error("projection is invalid: {0}")]
     Projection(&'static str),
