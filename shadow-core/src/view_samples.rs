@@ -13,7 +13,6 @@ use crate::camera::Camera;
 use crate::raster::{NO_TRIANGLE, RasterError, RasterView, rasterize};
 use crate::scene::Scene;
 
-
 /// The largest view, in pixels (8192 x 4096): view samples cost about 64 bytes a pixel (2 GiB
 /// here), a technique's outputs more (per-sample visibility: `N / 8` bytes a pixel), so a larger
 /// request is refused before anything is allocated rather than exhausting memory.

@@ -613,3 +613,27 @@ fn uris_may_not_leave_the_scenes_folder() {
     assert!(load_gltf(&dir.join("scene.gltf"), &LoadLimits::default()).is_ok());
     std::fs::remove_dir_all(&root).ok();
 }
+
+/// Issue 51, item 8: a light node with a mirroring scale (negative determinant) flipped the
+/// light's facing, and direct illumination became 0; the winding is reversed back, so the
+/// light's front is the mirror image of its front: the local normal under the node's
+/// inverse-transpose (unchanged by a mirror within the light's plane, reversed by one across it).
+#[test]
+fn a_mirrored_light_node_keeps_its_facing() {
+    let normal_of = |doc: &Value| match load(doc).unwrap().lights[0].geometry() {
+        LightGeometry::Rectangle { normal, .. } => normal,
+        g => panic!("expected a rectangle, got {g:?}"),
+    };
+    // Unmirrored (scale [2, 1, 1]) the lamp faces down: its local normal is -Y.
+    assert!((normal_of(&test_document()) - Vec3::NEG_Y).length() < 1e-5);
+    for scale in [[-2.0f32, 1.0, 1.0], [2.0, 1.0, -1.0], [-2.0, -1.0, -1.0]] {
+        let mut doc = test_document();
+        doc["nodes"][3]["scale"] = json!(scale);
+        let expected = Vec3::new(0.0, -1.0 / scale[1], 0.0).normalize();
+        let n = normal_of(&doc);
+        assert!(
+            (n - expected).length() < 1e-5,
+            "{scale:?}: {n} against {expected}"
+        );
+    }
+}

@@ -128,7 +128,15 @@ pub fn load_gltf_slice(
                     Some(a) => read_indices(&buffers, &a, limits)?,
                     None => (0..positions.len() as u32).collect(),
                 };
-                let triangles = assemble(prim.mode(), &indices, &mesh_name)?;
+                let mut triangles = assemble(prim.mode(), &indices, &mesh_name)?;
+                // A mirroring node (negative determinant) reverses the winding that makes the
+                // front face (glTF 2.0, "Transformations"): reverse it back, so that lights
+                // keep facing where they face and closed meshes keep their outward side.
+                if glam::Mat3::from_mat4(world).determinant() < 0.0 {
+                    for t in &mut triangles {
+                        t.swap(1, 2);
+                    }
+                }
                 if let Some(&bad) = triangles
                     .iter()
                     .flatten()
