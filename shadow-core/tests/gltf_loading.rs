@@ -637,3 +637,21 @@ fn a_mirrored_light_node_keeps_its_facing() {
         );
     }
 }
+
+/// Issue 51, item 17: garbage that is neither GLB nor JSON said "expected value at line 1
+/// column 1"; it says it is not a glTF file. A limit names its quantity and unit, and an
+/// accessor count is not called bytes.
+#[test]
+fn load_errors_say_what_is_wrong() {
+    let limits = LoadLimits::default();
+    let e = load_gltf_slice(b"\x89PNG garbage", None, "x", &limits).unwrap_err();
+    assert!(e.to_string().contains("not a glTF file"), "{e}");
+    let mut doc = test_document();
+    doc["accessors"][0]["count"] = json!(1u64 << 40);
+    let e = load(&doc).unwrap_err();
+    let text = e.to_string();
+    assert!(
+        text.contains("element count") && !text.contains("bytes"),
+        "{text}"
+    );
+}

@@ -43,8 +43,17 @@ pub fn load_gltf_slice(
     name: &str,
     limits: &LoadLimits,
 ) -> Result<SceneSetup, LoadError> {
-    let gltf = gltf::Gltf::from_slice_without_validation(bytes)
-        .map_err(|e| LoadError::Gltf(e.to_string()))?;
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| {
+        // Neither a GLB (magic `glTF`) nor a JSON object: say so, not what the JSON parser met.
+        let json_like = bytes.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'{');
+        if bytes.starts_with(b"glTF") || json_like {
+            LoadError::Gltf(e.to_string())
+        } else {
+            LoadError::Gltf(format!(
+                "not a glTF file: neither GLB (magic `glTF`) nor a JSON object ({e})"
+            ))
+        }
+    })?;
     // gltf-json's validation dereferences a primitive's POSITION accessor unchecked (a missing
     // one panics): every index a primitive names is checked here first.
     check_primitive_indices(gltf.document.as_json())?;
@@ -119,7 +128,7 @@ pub fn load_gltf_slice(
                 vertices_total += positions.len() as u64;
                 if vertices_total > limits.max_vertices {
                     return Err(LoadError::Limit {
-                        what: "vertex count".into(),
+                        what: "the scene's vertex count".into(),
                         size: vertices_total,
                         limit: limits.max_vertices,
                     });
@@ -258,7 +267,7 @@ fn decode_data_uri(uri: &str, limit: u64) -> Result<Option<Vec<u8>>, LoadError> 
     let decoded_len = (data.len() as u64 / 4) * 3;
     if decoded_len > limit {
         return Err(LoadError::Limit {
-            what: "data URI".into(),
+            what: "a data URI's decoded length in bytes".into(),
             size: decoded_len,
             limit,
         });
@@ -307,7 +316,7 @@ fn load_buffers(
         let declared = buffer.length() as u64;
         if declared > limits.max_buffer_bytes {
             return Err(LoadError::Limit {
-                what: format!("buffer {}", buffer.index()),
+                what: format!("buffer {}'s declared length in bytes", buffer.index()),
                 size: declared,
                 limit: limits.max_buffer_bytes,
             });
@@ -338,7 +347,10 @@ fn load_buffers(
         };
         if (data.len() as u64) < declared {
             return Err(LoadError::Limit {
-                what: format!("buffer {} (bytes present)", buffer.index()),
+                what: format!(
+                    "buffer {}'s declared length in bytes (the limit is the bytes present)",
+                    buffer.index()
+                ),
                 size: declared,
                 limit: data.len() as u64,
             });
@@ -382,7 +394,7 @@ fn elements<'a>(
     let count = acc.count() as u64;
     if count > limits.max_vertices * 3 {
         return Err(LoadError::Limit {
-            what: format!("accessor {} count", acc.index()),
+            what: format!("accessor {}'s element count", acc.index()),
             size: count,
             limit: limits.max_vertices * 3,
         });
@@ -597,7 +609,7 @@ fn load_image(
     let (w, h) = (img.width(), img.height());
     if w as u64 * h as u64 > limits.max_image_pixels {
         return Err(LoadError::Limit {
-            what: "texture pixels".into(),
+            what: "the texture's pixel count".into(),
             size: w as u64 * h as u64,
             limit: limits.max_image_pixels,
         });

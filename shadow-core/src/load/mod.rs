@@ -63,8 +63,9 @@ pub enum LoadError {
     /// The OBJ file is malformed.
     #[error("malformed OBJ: {0}")]
     Obj(String),
-    /// A declared size exceeds a limit or the data present.
-    #[error("{what} declares {size} bytes, limit {limit}")]
+    /// A declared size exceeds a limit or the data present (`what` names the quantity and its
+    /// unit).
+    #[error("{what} is {size}, above the limit of {limit}")]
     Limit {
         /// What was too large.
         what: String,
@@ -178,7 +179,7 @@ pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, LoadError
     let len = std::fs::metadata(path).map_err(io)?.len();
     if len > limit {
         return Err(LoadError::Limit {
-            what: path.display().to_string(),
+            what: format!("the size of {} in bytes", path.display()),
             size: len,
             limit,
         });

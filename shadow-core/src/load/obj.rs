@@ -81,7 +81,7 @@ pub fn read_obj_mesh(
         }
         if (positions.len() + p.len() / 3) as u64 > limits.max_vertices {
             return Err(LoadError::Limit {
-                what: "vertex count".into(),
+                what: "the scene's vertex count".into(),
                 size: (positions.len() + p.len() / 3) as u64,
                 limit: limits.max_vertices,
             });
