@@ -487,3 +487,55 @@ fn a_scene_with_several_lights_needs_a_choice() {
     assert!(!run(&["--light", "2"]).status.success());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Issue 49: the conformance table's speed-up for an exact sample-based technique read `>251x`,
+/// because its error was taken against the same-samples reference (0 by construction); it is
+/// taken against the independent stratified reference.
+#[test]
+fn conformance_speedups_are_against_the_independent_reference() {
+    let dir = temp_dir("conformance-speedup");
+    let out = xtask(&[
+        "conformance",
+        "--scenes",
+        "quad-over-plane",
+        "--techniques",
+        "dcs-16,pcss",
+        "--quick",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--ref-samples",
+        "256",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
+    let case = |name: &str| {
+        report["cases"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["technique"] == name)
+            .unwrap()
+            .clone()
+    };
+    let dcs = case("dcs-16");
+    // Exact against its own samples, noisy against the independent reference.
+    assert!(dcs["metrics"]["rmse"].as_f64().unwrap() < 1e-3);
+    let independent = dcs["rmse_against_independent_reference"].as_f64().unwrap();
+    assert!(independent > 1e-3, "{independent}");
+    // A shadow-map technique has no samples of its own: one reference, one error.
+    let pcss = case("pcss");
+    assert_eq!(
+        pcss["rmse_against_independent_reference"],
+        pcss["metrics"]["rmse"]
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
