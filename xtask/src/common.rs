@@ -12,8 +12,8 @@ use shadow_core::prelude::*;
 use shadow_core::scenes::{BUILTIN_SCENES, builtin};
 
 /// A built-in scene by name, or a scene file by path. A file without an emissive mesh gets a
-/// square light above its bounds (said on stderr).
-pub fn resolve_scene(name: &str) -> Result<SceneSetup, String> {
+/// square light above its bounds (said on stderr) unless `own_light` (the caller brings one).
+pub fn resolve_scene(name: &str, own_light: bool) -> Result<SceneSetup, String> {
     if BUILTIN_SCENES.contains(&name) {
         return builtin(name).map_err(|e| e.to_string());
     }
@@ -28,7 +28,7 @@ pub fn resolve_scene(name: &str) -> Result<SceneSetup, String> {
     for w in &setup.warnings {
         eprintln!("note: {w}");
     }
-    if setup.lights.is_empty() {
+    if setup.lights.is_empty() && !own_light {
         let b = setup.scene.bounds();
         let d = b.diagonal().max(1e-3);
         let c = Vec3::new(b.center().x, b.max.y + 0.8 * d, b.center().z);

@@ -9,6 +9,7 @@
 mod bench;
 mod common;
 mod conformance;
+mod overrides;
 mod plot;
 mod render;
 mod stress;

@@ -36,7 +36,18 @@ pub struct RenderArgs {
     /// Which of the scene's lights to shadow (0-based, in file order); a scene with several
     /// lights needs it.
     #[arg(long)]
-    light: Option<usize>,
+    light_index: Option<usize>,
+    /// A light in place of the file's: `rect:CENTER:NORMAL:WIDTHxHEIGHT`,
+    /// `disk:CENTER:NORMAL:RADIUS` or `sphere:CENTER:RADIUS` (points and directions `x,y,z`).
+    #[arg(long)]
+    light: Option<String>,
+    /// The radiance of `--light`: `R,G,B`, or one value for all three (default 1).
+    #[arg(long)]
+    light_radiance: Option<String>,
+    /// A camera in place of the file's: `EYE:TARGET:FOV` (points `x,y,z`, vertical field of
+    /// view in degrees, +Y up).
+    #[arg(long)]
+    camera: Option<String>,
     /// Seed of the technique's sampling.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -63,7 +74,17 @@ const OUTPUTS: [&str; 8] = [
 ];
 
 pub fn run(a: RenderArgs) -> Result<(), String> {
-    let setup = resolve_scene(&a.scene)?;
+    let mut setup = resolve_scene(&a.scene, a.light.is_some())?;
+    if let Some(spec) = &a.light {
+        let radiance = crate::overrides::radiance(a.light_radiance.as_deref())?;
+        setup.lights = vec![crate::overrides::light(spec, radiance)?];
+    } else if a.light_radiance.is_some() {
+        return Err("--light-radiance needs --light".into());
+    }
+    if let Some(spec) = &a.camera {
+        setup.camera = Some(crate::overrides::camera(spec)?);
+        setup.aspect = None;
+    }
     let technique = match &a.technique {
         Some(t) => Some(resolve_technique(t, a.samples, a.seed)?),
         None => None,
@@ -71,7 +92,7 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
     if a.technique.is_none() && a.samples.is_some() && !a.direct {
         return Err("--samples needs --technique or --direct".into());
     }
-    let light_index = choose_light(&setup, a.light)?;
+    let light_index = choose_light(&setup, a.light_index)?;
     let light = setup.lights[light_index].clone();
     let height = a.height.unwrap_or_else(|| match setup.aspect {
         Some(r) if r > 0.0 && r.is_finite() => ((a.width as f32 / r).round() as u32).max(1),
@@ -216,13 +237,13 @@ fn choose_light(setup: &SceneSetup, chosen: Option<usize>) -> Result<usize, Stri
     match chosen {
         Some(k) if k < n => Ok(k),
         Some(k) => Err(format!(
-            "--light {k}: `{}` has {n} light(s) ({})",
+            "--light-index {k}: `{}` has {n} light(s) ({})",
             setup.name,
             list()
         )),
         None if n == 1 => Ok(0),
         None => Err(format!(
-            "`{}` has {n} lights ({}); choose one with --light K",
+            "`{}` has {n} lights ({}); choose one with --light-index K",
             setup.name,
             list()
         )),

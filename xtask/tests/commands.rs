@@ -442,7 +442,7 @@ fn square_at(y: f32, h: f32, x: f32, down: bool) -> Vec<[f32; 3]> {
 }
 
 /// Issue 51, item 9: a second emissive mesh was ignored without a word; a scene with several
-/// lights is refused with a list of them unless `--light K` picks one.
+/// lights is refused with a list of them unless `--light-index K` picks one.
 #[test]
 fn a_scene_with_several_lights_needs_a_choice() {
     let dir = temp_dir("two-lights");
@@ -473,8 +473,11 @@ fn a_scene_with_several_lights_needs_a_choice() {
     let out = run(&[]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());
-    assert!(err.contains("2 lights") && err.contains("--light"), "{err}");
-    let out = run(&["--light", "1"]);
+    assert!(
+        err.contains("2 lights") && err.contains("--light-index"),
+        "{err}"
+    );
+    let out = run(&["--light-index", "1"]);
     assert!(
         out.status.success(),
         "{}",
@@ -484,7 +487,7 @@ fn a_scene_with_several_lights_needs_a_choice() {
         serde_json::from_str(&std::fs::read_to_string(out_dir.join("stats.json")).unwrap())
             .unwrap();
     assert_eq!(stats["light_index"], 1);
-    assert!(!run(&["--light", "2"]).status.success());
+    assert!(!run(&["--light-index", "2"]).status.success());
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -536,6 +539,98 @@ fn conformance_speedups_are_against_the_independent_reference() {
     assert_eq!(
         pcss["rmse_against_independent_reference"],
         pcss["metrics"]["rmse"]
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Issue 52, item 1: a light and a camera on the command line give the same image as the same
+/// scene built in code (`RectLight::facing`, `Camera::look_at`) and shadowed through the library.
+#[test]
+fn a_command_line_light_and_camera_match_the_scene_built_in_code() {
+    use shadow_core::prelude::*;
+    let dir = temp_dir("cli-light");
+    std::fs::create_dir_all(&dir).unwrap();
+    let obj = dir.join("plain.obj");
+    std::fs::write(
+        &obj,
+        "v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\n\
+         v -0.5 1 -0.5\nv 0.5 1 -0.5\nv 0.5 1 0.5\nv -0.5 1 0.5\n\
+         f 1 4 3 2\nf 5 8 7 6\n",
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let out = xtask(&[
+        "render",
+        "--scene",
+        obj.to_str().unwrap(),
+        "--light",
+        "rect:0.2,2.5,0.1:0,-1,0:1.2x0.8",
+        "--light-radiance",
+        "2",
+        "--camera",
+        "0,3,5:0,0,0:40",
+        "--technique",
+        "ref-16",
+        "--width",
+        "24",
+        "--height",
+        "18",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        !err.contains("square light"),
+        "no default light with --light: {err}"
+    );
+    // The same scene, light, camera and technique in code.
+    let setup =
+        shadow_core::load::load_scene(&obj, &shadow_core::load::LoadLimits::default()).unwrap();
+    let light: Light = std::sync::Arc::new(
+        RectLight::facing(
+            glam::Vec3::new(0.2, 2.5, 0.1),
+            glam::Vec3::NEG_Y,
+            1.2,
+            0.8,
+            Radiance::Constant(glam::Vec3::splat(2.0)),
+        )
+        .unwrap(),
+    );
+    let camera = Camera::look_at(
+        glam::Vec3::new(0.0, 3.0, 5.0),
+        glam::Vec3::ZERO,
+        glam::Vec3::Y,
+        40f32.to_radians(),
+    )
+    .unwrap();
+    let view = ViewSamples::render(setup.scene.as_ref(), &camera, 24, 18).unwrap();
+    let est = shadow_ref::Reference::stratified(16, 1)
+        .unwrap()
+        .prepare(setup.scene.clone(), light)
+        .unwrap()
+        .estimate(&view, Outputs::VISIBILITY)
+        .unwrap();
+    let exr = image::open(out_dir.join("visibility.exr"))
+        .unwrap()
+        .to_rgba32f();
+    let (mut valid, mut shadowed) = (0, 0);
+    for (i, p) in exr.pixels().enumerate() {
+        assert_eq!(p.0[3] == 1.0, view.is_valid(i), "pixel {i}");
+        if view.is_valid(i) {
+            valid += 1;
+            let v = est.visibility.value(i);
+            shadowed += (v < 0.5) as u32;
+            assert!(
+                (p.0[0] - v).abs() < 1e-6,
+                "pixel {i}: {} against {v}",
+                p.0[0]
+            );
+        }
+    }
+    assert!(
+        valid > 100 && shadowed > 5,
+        "{valid} valid, {shadowed} shadowed"
     );
     std::fs::remove_dir_all(&dir).ok();
 }
