@@ -82,11 +82,45 @@ impl ShadowMap {
         if !(lo.x <= hi.x) {
             return Ok(None);
         }
+        // Every point that can stand between a receiver and the light projects within
+        // `width / (2 z)` of the receiver's projection (z its depth below the light plane). When
+        // that margin is at most the receivers' own extent the map is their square widened by
+        // it (the setting every budget was measured at). When it is wider, as under a wide
+        // light with a small view, the map reaches as far as the margin, never less (a cap
+        // here lost occluders beside the view), and no farther than the geometry projects. Its
+        // texels grow with it: a finer map would need kernels beyond the filters' caps
+        // (`MAX_KERNEL`) to reach the occluders it now holds.
         let size = (hi - lo).max_element().max(1e-6);
-        let margin = (frame.width / (2.0 * z_min_scene.max(near))).min(size);
-        // A square frustum (square texels), centred on the receivers.
-        let mid = (lo + hi) * 0.5;
-        let half = size * 0.5 + margin;
+        let margin = frame.width / (2.0 * z_min_scene.max(near));
+        let (mid, half, resolution) = if margin <= size {
+            ((lo + hi) * 0.5, size * 0.5 + margin, resolution)
+        } else {
+            let (mut glo, mut ghi) = (lo - margin, hi + margin);
+            let mut all_in_front = true;
+            let (mut plo, mut phi) = (
+                glam::Vec2::splat(f32::INFINITY),
+                glam::Vec2::splat(f32::NEG_INFINITY),
+            );
+            for p in scene.positions() {
+                let v = view_from_world.transform_point3(*p);
+                let d = -v.z;
+                if d > near {
+                    let q = glam::Vec2::new(v.x / d, v.y / d);
+                    plo = plo.min(q);
+                    phi = phi.max(q);
+                } else {
+                    all_in_front = false;
+                }
+            }
+            // With a vertex behind the near plane a triangle's projection is not bounded by
+            // its vertices' projections in front: the margin alone bounds the map then.
+            if all_in_front && plo.x <= phi.x {
+                glo = glo.max(plo.min(lo));
+                ghi = ghi.min(phi.max(hi));
+            }
+            let half = (ghi - glo).max_element().max(1e-6) * 0.5;
+            ((glo + ghi) * 0.5, half, resolution)
+        };
         let view = RasterView {
             width: resolution,
             height: resolution,
