@@ -105,3 +105,19 @@ pub fn silhouette_edges(scene: &dyn Scene, bounds: &LightBounds) -> Vec<Caster> 
     }
     out
 }
+
+/// How many closed meshes (components flagged in `closed`) separate `eye` from the light: hold
+/// the one and not the other (`around_light`, per component)
+/// ([`shadow_core::scene::components_containing`]).
+pub(crate) fn closed_meshes_between(
+    scene: &dyn Scene,
+    closed: &[bool],
+    around_light: &[bool],
+    eye: Vec3,
+) -> usize {
+    shadow_core::scene::components_containing(scene, eye.as_dvec3(), closed)
+        .iter()
+        .zip(around_light)
+        .filter(|(eye_in, light_in)| eye_in != light_in)
+        .count()
+}

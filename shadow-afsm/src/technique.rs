@@ -62,6 +62,18 @@ struct Prepared {
     bounds: LightBounds,
     offset: RayOffset,
     batches: Vec<CasterBatch>,
+    /// Per topology component: closed and consistently oriented, so that only its light
+    /// back-facing triangles cast (section 3.3) for an eye outside it.
+    closed: Vec<bool>,
+    /// Per component: whether it holds the light's centre.
+    around_light: Vec<bool>,
+    /// Every caster with no component taken as closed, uploaded the first time an eye lies
+    /// inside a closed mesh that the light is outside of, or outside one that holds the light
+    /// (its receivers' segments then cross that mesh an odd number of times, through a front
+    /// face alone).
+    open_batches: std::sync::OnceLock<Result<Vec<CasterBatch>, TechniqueError>>,
+    /// Casters per batch within the binding limit.
+    per_batch: usize,
     semi_opaque: bool,
     silhouettes: Vec<CasterBatch>,
     silhouette_count: usize,
@@ -116,6 +128,39 @@ impl std::fmt::Debug for Afsm {
 
 fn device_error(e: GpuError) -> TechniqueError {
     TechniqueError::Device(e.to_string())
+}
+
+/// The casters of `scene`: every triangle that hides anything (fully transparent ones are
+/// left out), flagged closed when its component is in `closed`.
+fn casters_of(scene: &dyn Scene, closed: &[bool]) -> Vec<Caster> {
+    let topo = scene.topology();
+    let opacities = scene.opacities();
+    (0..scene.triangle_count())
+        .filter(|&t| opacities[t] > 0.0)
+        .map(|t| {
+            Caster::new(scene.triangle(t), t as u32, closed[topo.component_of(t)])
+                .with_opacity(opacities[t])
+        })
+        .collect()
+}
+
+/// `casters` in buffers of at most `per` casters each.
+fn upload_casters(
+    gpu: &GpuContext,
+    casters: &[Caster],
+    per: usize,
+    label: &str,
+) -> Result<Vec<CasterBatch>, TechniqueError> {
+    casters
+        .chunks(per)
+        .map(|c| {
+            Ok(CasterBatch {
+                buffer: gpu.storage(label, c)?,
+                len: c.len() as u32,
+            })
+        })
+        .collect::<Result<Vec<_>, GpuError>>()
+        .map_err(device_error)
 }
 
 impl Afsm {
@@ -320,29 +365,16 @@ impl Afsm {
             .iter()
             .map(|c| c.closed && c.consistently_oriented)
             .collect();
-        // Fully transparent triangles never hide anything and are left out.
-        let opacities = scene.opacities();
-        let casters: Vec<Caster> = (0..scene.triangle_count())
-            .filter(|&t| opacities[t] > 0.0)
-            .map(|t| {
-                Caster::new(scene.triangle(t), t as u32, closed[topo.component_of(t)])
-                    .with_opacity(opacities[t])
-            })
-            .collect();
+        let casters = casters_of(scene.as_ref(), &closed);
+        let around_light = shadow_core::scene::components_containing(
+            scene.as_ref(),
+            light.center().as_dvec3(),
+            &closed,
+        );
         let semi_opaque = casters.iter().any(|c| c.optical_depth != OPAQUE);
         let limit = self.binding_limit(&gpu);
         let per = (limit / std::mem::size_of::<Region>() as u64).max(1) as usize;
-        let upload = |all: &[Caster], label: &str| {
-            all.chunks(per)
-                .map(|c| {
-                    Ok(CasterBatch {
-                        buffer: gpu.storage(label, c)?,
-                        len: c.len() as u32,
-                    })
-                })
-                .collect::<Result<Vec<_>, GpuError>>()
-                .map_err(device_error)
-        };
+        let upload = |all: &[Caster], label: &str| upload_casters(&gpu, all, per, label);
         let batches = upload(&casters, "casters")?;
         // The stencil pays only when there are several samples to skip.
         let edges = if self.stencil && !self.hard && self.samples > 1 {
@@ -403,6 +435,10 @@ impl Afsm {
             bounds,
             offset: RayOffset::for_extent(extent),
             batches,
+            around_light,
+            closed,
+            open_batches: std::sync::OnceLock::new(),
+            per_batch: per,
             semi_opaque,
             silhouettes,
             silhouette_count: edges.len(),
@@ -571,6 +607,24 @@ impl Afsm {
                 }
             })
             .collect();
+        // Light back-facing casters alone are exact when a receiver's segment crosses each
+        // closed mesh an even number of times: when receiver and light are on the same side of
+        // it. Every visible receiver is on the eye's side, so a closed mesh that separates the
+        // eye from the light makes every face cast.
+        let separating = view.eye().map_or(0, |e| {
+            crate::inputs::closed_meshes_between(p.scene.as_ref(), &p.closed, &p.around_light, e)
+        });
+        stats.add("closed-meshes-between-eye-and-light", separating as u64);
+        let casters: &[CasterBatch] = if separating > 0 {
+            let open = p.open_batches.get_or_init(|| {
+                let all_open = vec![false; p.closed.len()];
+                let casters = casters_of(p.scene.as_ref(), &all_open);
+                upload_casters(&p.gpu, &casters, p.per_batch, "casters, none closed")
+            });
+            open.as_ref().map_err(Clone::clone)?
+        } else {
+            &p.batches
+        };
         let mut stages = Vec::new();
         let (mut occupied, mut longest, mut batches) = (0u64, 0u64, 0u64);
         let mut tallies = [0u64; TALLIES.len()];
@@ -589,7 +643,7 @@ impl Afsm {
             )
             .map_err(device_error)?;
             let shared = Shared {
-                casters: &p.batches,
+                casters,
                 samples: &p.samples,
                 radiance: &p.radiance,
                 lut: &p.lut,
@@ -655,7 +709,7 @@ impl Afsm {
         stats.add("receivers-listed", receivers.len() as u64);
         stats.add("receivers-facing-away", facing_away);
         stats.add("receiver-batches", batches);
-        stats.add("caster-batches", p.batches.len() as u64);
+        stats.add("caster-batches", casters.len() as u64);
         stats.add("silhouette-edges", p.silhouette_count as u64);
         stats.add("lists-occupied", occupied);
         stats.gauge_max("list-length-max", longest);

@@ -3,6 +3,7 @@
 
 use std::sync::Arc;
 
+use glam::Vec3;
 use shadow_afsm::{Afsm, accumulate};
 use shadow_core::gpu::context_for_test;
 use shadow_core::metrics::compare;
@@ -343,4 +344,57 @@ fn polygon_light_agrees_with_the_same_samples_reference() {
     println!("{m:?}");
     assert!(m.sample_agreement.unwrap() >= 0.999, "{m:?}");
     assert!(m.rmse < 0.004, "{m:?}");
+}
+
+/// Issue 51, item 7: receivers inside a closed mesh (a camera in a closed box, the light
+/// outside above it) got V = 1 from `afsm-hard` and `afsm-128`, because a closed mesh keeps
+/// only its light back-facing triangles and the segment from an inside receiver leaves through
+/// a front-facing one; the reference gives 0. A closed mesh around the eye keeps every face.
+#[test]
+fn receivers_inside_a_closed_mesh_are_shadowed() {
+    if context_for_test("receivers_inside_a_closed_mesh_are_shadowed").is_none() {
+        return;
+    }
+    let mut b = SceneBuilder::new();
+    let f = shadow_core::procedural::floor(1.6, 0.05);
+    b.push_mesh(MeshDesc::new(f.0, f.1)).unwrap();
+    let shell = shadow_core::procedural::cuboid(
+        Vec3::new(-1.0, 0.0, -1.0),
+        Vec3::new(1.0, 2.0, 1.0),
+        false,
+    );
+    b.push_mesh(MeshDesc::new(shell.0, shell.1)).unwrap();
+    let scene: SceneRef = Arc::new(b.build().unwrap());
+    assert!(scene.topology().components().iter().any(|c| c.closed));
+    let light: Light = Arc::new(
+        RectLight::facing(
+            Vec3::new(0.0, 3.0, 0.0),
+            Vec3::NEG_Y,
+            0.8,
+            0.8,
+            Radiance::constant(Vec3::ONE).unwrap(),
+        )
+        .unwrap(),
+    );
+    let camera = Camera::look_at(Vec3::new(0.0, 1.5, 0.8), Vec3::ZERO, Vec3::Y, 1.2).unwrap();
+    let view = ViewSamples::render(scene.as_ref(), &camera, 32, 24).unwrap();
+    for afsm in [
+        Afsm::hard(),
+        Afsm::new(128, SamplingStrategy::Interleaved { tile: 4 }, 1).unwrap(),
+    ] {
+        let est = afsm
+            .prepare(scene.clone(), light.clone())
+            .unwrap()
+            .estimate(&view, Outputs::VISIBILITY)
+            .unwrap();
+        let lit = (0..view.len())
+            .filter(|&i| view.is_valid(i) && est.visibility.value(i) > 0.01)
+            .count();
+        assert_eq!(
+            lit,
+            0,
+            "{}: {lit} pixels see the light through the box",
+            afsm.name()
+        );
+    }
 }

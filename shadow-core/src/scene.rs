@@ -2,7 +2,7 @@
 //! constructors (DESIGN section 3): non-finite coordinates, out-of-range indices, zero-area
 //! triangles and opacities outside [0, 1] are typed errors, never passed on to a technique.
 
-use glam::{Affine3A, Vec3};
+use glam::{Affine3A, DVec3, Vec3};
 use thiserror::Error;
 
 use crate::geometry::{Aabb, triangle_cross_f64, triangle_normal};
@@ -542,6 +542,28 @@ impl SceneBuilder {
             semi_opaque,
         })
     }
+}
+
+/// For each topology component flagged in `among` (indexed by component), whether it holds
+/// `p`: the parity of a ray's crossings with its triangles, along a direction no regular mesh
+/// is aligned with. Meaningful for closed meshes; `false` for components not flagged.
+pub fn components_containing(scene: &dyn Scene, p: DVec3, among: &[bool]) -> Vec<bool> {
+    let topo = scene.topology();
+    let dir = DVec3::new(0.577_215_664_9, 0.312_029_995_7, 0.759_134_812_3).normalize();
+    let mut inside = vec![false; among.len()];
+    if !among.iter().any(|c| *c) {
+        return inside;
+    }
+    for t in 0..scene.triangle_count() {
+        let c = topo.component_of(t);
+        if among[c] {
+            let [a, b, v] = scene.triangle(t).map(|q| q.as_dvec3());
+            if crate::geometry::ray_hits_triangle(p, dir, a, b, v, f64::INFINITY) {
+                inside[c] = !inside[c];
+            }
+        }
+    }
+    inside
 }
 
 #[cfg(test)]

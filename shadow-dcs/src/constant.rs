@@ -24,7 +24,9 @@ use rayon::prelude::*;
 use shadow_core::raster::{CoveredPolygon, Projection, RasterView};
 use shadow_core::scene::Scene;
 
-use crate::edges::{SceneEdge, ray_hits_triangle};
+use shadow_core::geometry::ray_hits_triangle;
+
+use crate::edges::SceneEdge;
 
 /// Far vertices lie at this many times the largest eye or sample distance from `c`: a quad's
 /// far edge is a chord, and it stays beyond every view sample unless the edge subtends more

@@ -132,14 +132,18 @@ pub(crate) fn scene_edges(scene: &dyn Scene, light_center: Vec3) -> (Vec<SceneEd
     let semi = scene.has_semi_opaque();
     let units = if semi { OPACITY_UNITS } else { 1 };
     let c = light_center.as_dvec3();
-    // Which closed, oriented components count from one side only.
-    let one_sided: Vec<bool> = topo
+    // Which closed, oriented components count from one side only: those that do not hold the
+    // light centre.
+    let closed: Vec<bool> = topo
         .components()
         .iter()
-        .enumerate()
-        .map(|(ci, comp)| {
-            comp.closed && comp.consistently_oriented && !contains_point(scene, ci, c)
-        })
+        .map(|comp| comp.closed && comp.consistently_oriented)
+        .collect();
+    let around_centre = shadow_core::scene::components_containing(scene, c, &closed);
+    let one_sided: Vec<bool> = closed
+        .iter()
+        .zip(&around_centre)
+        .map(|(closed, around)| *closed && !*around)
         .collect();
     let weight = |t: usize| -> u32 {
         if semi {
@@ -191,55 +195,6 @@ pub(crate) fn scene_edges(scene: &dyn Scene, light_center: Vec3) -> (Vec<SceneEd
         });
     }
     (out, units)
-}
-
-/// Parity of the crossings of a ray from `p` with the triangles of component `comp`.
-fn contains_point(scene: &dyn Scene, comp: usize, p: DVec3) -> bool {
-    let topo = scene.topology();
-    // An irrational-looking direction keeps the ray off edges and vertices of regular meshes.
-    let dir = DVec3::new(0.577_215_664_9, 0.312_029_995_7, 0.759_134_812_3).normalize();
-    let mut inside = false;
-    for t in 0..scene.triangle_count() {
-        if topo.component_of(t) != comp {
-            continue;
-        }
-        let [a, b, c] = scene.triangle(t).map(|v| v.as_dvec3());
-        if ray_hits_triangle(p, dir, a, b, c, f64::INFINITY) {
-            inside = !inside;
-        }
-    }
-    inside
-}
-
-/// Möller-Trumbore in f64: does the ray `o + t d`, `0 < t < t_max`, hit the triangle?
-pub(crate) fn ray_hits_triangle(
-    o: DVec3,
-    d: DVec3,
-    a: DVec3,
-    b: DVec3,
-    c: DVec3,
-    t_max: f64,
-) -> bool {
-    let e1 = b - a;
-    let e2 = c - a;
-    let pv = d.cross(e2);
-    let det = e1.dot(pv);
-    if det == 0.0 {
-        return false;
-    }
-    let inv = 1.0 / det;
-    let tv = o - a;
-    let u = tv.dot(pv) * inv;
-    if !(0.0..=1.0).contains(&u) {
-        return false;
-    }
-    let qv = tv.cross(e1);
-    let v = d.dot(qv) * inv;
-    if v < 0.0 || u + v > 1.0 {
-        return false;
-    }
-    let t = e2.dot(qv) * inv;
-    t > 0.0 && t < t_max
 }
 
 /// The silhouette edges of `edges` for a light (indices into `edges`).
