@@ -655,3 +655,31 @@ fn load_errors_say_what_is_wrong() {
         "{text}"
     );
 }
+
+/// Issue 52, item 7: material data was dropped without a word. Extensions the loader does not
+/// read and base-colour textures (albedo is the factor) are named in the setup's warnings.
+#[test]
+fn ignored_material_data_is_named_in_a_note() {
+    let mut doc = test_document();
+    doc["extensionsUsed"] = json!([
+        "KHR_materials_emissive_strength",
+        "KHR_materials_transmission"
+    ]);
+    doc["materials"][0]["name"] = json!("grey paint");
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = json!({"index": 0});
+    let setup = load(&doc).unwrap();
+    let all = setup.warnings.join("\n");
+    assert!(all.contains("KHR_materials_transmission"), "{all}");
+    assert!(all.contains("opaque shadows"), "{all}");
+    assert!(
+        !all.contains("extension KHR_materials_emissive_strength"),
+        "{all}"
+    );
+    assert!(
+        all.contains("base-colour textures") && all.contains("grey paint"),
+        "{all}"
+    );
+    // A file that uses nothing unread says nothing.
+    let plain = load(&test_document()).unwrap();
+    assert!(plain.warnings.is_empty(), "{:?}", plain.warnings);
+}
