@@ -45,6 +45,7 @@ pub mod geometry;
 #[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod image_io;
+pub mod irradiance;
 pub mod light;
 pub mod load;
 pub mod metrics;

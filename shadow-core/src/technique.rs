@@ -9,11 +9,11 @@ use glam::Vec3;
 use serde::Serialize;
 use thiserror::Error;
 
-use crate::light::{AreaLight, Light, LightKind};
+use crate::light::{AreaLight, Light, LightKind, LightSample};
 use crate::raster::RasterError;
 use crate::sampling::LightSampler;
 use crate::scene::Scene;
-use crate::view_samples::ViewSamples;
+use crate::view_samples::{ViewSample, ViewSamples};
 use crate::visibility::{VisibilityError, VisibilityImage};
 
 /// A scene shared between the caller and the techniques that keep it.
@@ -406,6 +406,57 @@ pub fn direct_from_per_sample(
     view: &ViewSamples,
     visibility: &VisibilityImage,
 ) -> Result<Vec<Vec3>, TechniqueError> {
+    shade_from_per_sample(
+        scene,
+        light,
+        sampler,
+        view,
+        visibility,
+        |s, albedo, samples, v| crate::direct::pixel_direct(s, albedo, light, samples, v),
+    )
+}
+
+/// Shadowed direct light by the ratio estimator ([`crate::irradiance`]): the closed-form
+/// unshadowed radiance of a planar constant light times the visible share of the eq. 6 terms
+/// of the same per-sample visibility as [`direct_from_per_sample`]. `Ok(None)` for lights
+/// without a closed form here (textured, sphere, point).
+///
+/// # Errors
+/// As [`direct_from_per_sample`].
+pub fn ratio_direct_from_per_sample(
+    scene: &dyn Scene,
+    light: &dyn AreaLight,
+    sampler: &LightSampler,
+    view: &ViewSamples,
+    visibility: &VisibilityImage,
+) -> Result<Option<Vec<Vec3>>, TechniqueError> {
+    if light.is_textured() || light.geometry().plane_normal().is_none() {
+        return Ok(None);
+    }
+    shade_from_per_sample(
+        scene,
+        light,
+        sampler,
+        view,
+        visibility,
+        |s, albedo, samples, v| {
+            crate::irradiance::pixel_ratio_direct(s, albedo, light, samples, v)
+                .unwrap_or(Vec3::ZERO)
+        },
+    )
+    .map(Some)
+}
+
+/// Runs `shade(view sample, albedo, its light samples, visibility of sample k)` on every valid
+/// pixel, from the per-sample visibility in `visibility` (background black).
+fn shade_from_per_sample(
+    scene: &dyn Scene,
+    light: &dyn AreaLight,
+    sampler: &LightSampler,
+    view: &ViewSamples,
+    visibility: &VisibilityImage,
+    shade: impl Fn(&ViewSample, Vec3, &[LightSample], &dyn Fn(usize) -> f32) -> Vec3 + Sync,
+) -> Result<Vec<Vec3>, TechniqueError> {
     use crate::visibility::VisibilityBuffer;
     use rayon::prelude::*;
     let per = visibility.per_sample().ok_or_else(|| {
@@ -433,9 +484,8 @@ pub fn direct_from_per_sample(
                 samples.clear();
                 light.sample_into(&units, &mut samples);
                 let albedo = scene.albedo(s.triangle as usize);
-                *px = crate::direct::pixel_direct(&s, albedo, light, &samples, |k| {
-                    if per.visible(i, k as u32) { 1.0 } else { 0.0 }
-                });
+                let v = |k: usize| if per.visible(i, k as u32) { 1.0 } else { 0.0 };
+                *px = shade(&s, albedo, &samples, &v);
             }
         });
     Ok(out)

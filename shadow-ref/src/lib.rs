@@ -13,7 +13,9 @@
 //! * [`watertight`]: the watertight ray-triangle test of Woop, Benthin and Wald (JCGT 2013),
 //!   one triangle or four at a time;
 //! * [`offset`]: robust ray origins after Wachter and Binder (Ray Tracing Gems ch. 6);
-//! * [`mod@reference`]: the [`Reference`] technique.
+//! * [`mod@reference`]: the [`Reference`] technique;
+//! * [`adaptive`]: the [`AdaptiveReference`] (`ref-adaptive-*`), per-pixel stratified batches
+//!   toward a standard-error target.
 //!
 //! ```
 //! use shadow_core::prelude::*;
@@ -29,6 +31,7 @@
 
 #![deny(missing_docs)]
 
+pub mod adaptive;
 pub mod beam;
 pub mod bvh;
 pub mod offset;
@@ -37,5 +40,6 @@ pub mod reference;
 pub mod watertight;
 pub mod wide;
 
+pub use adaptive::AdaptiveReference;
 pub use presets::presets;
 pub use reference::{PreparedReference, Reference};

@@ -10,7 +10,8 @@
 
 use shadow_core::prelude::*;
 
-use crate::Reference;
+use crate::adaptive::{DEFAULT_BATCH, DEFAULT_CAP};
+use crate::{AdaptiveReference, Reference};
 
 /// The stratified reference at `samples` samples, named `ref` at 1024 and `ref-N` otherwise.
 ///
@@ -26,7 +27,48 @@ fn stratified(samples: u32, seed: u64) -> Result<Box<dyn ShadowTechnique>, Techn
     Ok(Box::new(r.named(&name)))
 }
 
+/// The adaptive reference toward per-pixel standard error `target`, named `name`.
+fn adaptive(name: &str, target: f32, seed: u64) -> Box<dyn ShadowTechnique> {
+    Box::new(
+        AdaptiveReference::new(target, DEFAULT_BATCH, DEFAULT_CAP, seed)
+            .expect("the preset's target, batch and cap are valid")
+            .named(name),
+    )
+}
+
 /// Measured errors: scene, [rmse, penumbra rmse, bias, max, share > 0.1].
+const ADAPTIVE_01: &[(&str, [f64; 5])] = &[
+    ("quad-over-plane", [0.0021, 0.0052, 0.0001, 0.034, 0.0000]),
+    (
+        "overlapping-occluders",
+        [0.0026, 0.0040, -0.0000, 0.032, 0.0000],
+    ),
+    ("large-light-close", [0.0031, 0.0034, 0.0002, 0.021, 0.0000]),
+    ("bunny", [0.0018, 0.0049, -0.0000, 0.019, 0.0000]),
+    ("spot-self-shadow", [0.0021, 0.0042, 0.0001, 0.030, 0.0000]),
+    ("grass", [0.0026, 0.0068, 0.0000, 0.034, 0.0000]),
+    ("contact", [0.0015, 0.0044, 0.0000, 0.019, 0.0000]),
+    ("semi-opaque", [0.0011, 0.0014, -0.0000, 0.009, 0.0000]),
+    ("textured-light", [0.0029, 0.0029, 0.0000, 0.027, 0.0000]),
+    ("sphere-light", [0.0021, 0.0053, 0.0000, 0.024, 0.0000]),
+];
+
+const ADAPTIVE_003: &[(&str, [f64; 5])] = &[
+    ("quad-over-plane", [0.0015, 0.0036, 0.0000, 0.029, 0.0000]),
+    (
+        "overlapping-occluders",
+        [0.0020, 0.0030, 0.0001, 0.016, 0.0000],
+    ),
+    ("large-light-close", [0.0026, 0.0028, 0.0001, 0.021, 0.0000]),
+    ("bunny", [0.0012, 0.0033, 0.0000, 0.011, 0.0000]),
+    ("spot-self-shadow", [0.0017, 0.0033, 0.0000, 0.030, 0.0000]),
+    ("grass", [0.0019, 0.0050, 0.0000, 0.020, 0.0000]),
+    ("contact", [0.0010, 0.0031, -0.0000, 0.010, 0.0000]),
+    ("semi-opaque", [0.0010, 0.0014, -0.0000, 0.006, 0.0000]),
+    ("textured-light", [0.0021, 0.0021, 0.0000, 0.014, 0.0000]),
+    ("sphere-light", [0.0015, 0.0037, -0.0000, 0.013, 0.0000]),
+];
+
 const REF_16: &[(&str, [f64; 5])] = &[
     ("quad-over-plane", [0.0214, 0.0531, -0.0001, 0.189, 0.0114]),
     (
@@ -123,6 +165,22 @@ pub fn presets() -> Vec<Preset> {
             make: |seed| stratified(64, seed).expect("the preset\'s sample count is valid"),
             budget: |scene| Budget::lookup(REF_64, scene),
             with_samples: Some(stratified),
+            known_limitations: &[],
+        },
+        Preset {
+            name: "ref-adaptive-0.01",
+            description: "adaptive reference: stratified batches per pixel until its standard error is 0.01",
+            make: |seed| adaptive("ref-adaptive-0.01", 0.01, seed),
+            budget: |scene| Budget::lookup(ADAPTIVE_01, scene),
+            with_samples: None,
+            known_limitations: &[],
+        },
+        Preset {
+            name: "ref-adaptive-0.003",
+            description: "adaptive reference: stratified batches per pixel until its standard error is 0.003",
+            make: |seed| adaptive("ref-adaptive-0.003", 0.003, seed),
+            budget: |scene| Budget::lookup(ADAPTIVE_003, scene),
+            with_samples: None,
             known_limitations: &[],
         },
         Preset {

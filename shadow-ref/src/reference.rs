@@ -61,32 +61,32 @@ const BEAM_CANDIDATES: usize = 16;
 
 /// Per-thread buffers reused across receivers.
 #[derive(Default)]
-struct Scratch {
-    vis: Vec<f32>,
+pub(crate) struct Scratch {
+    pub(crate) vis: Vec<f32>,
     candidates: BeamCandidates,
 }
 
 /// What a receiver's beam found.
-struct ReceiverBeam {
+pub(crate) struct ReceiverBeam {
     origin: Vec3,
-    mode: BeamResult,
-    light_above: bool,
-    counts: Counts,
+    pub(crate) mode: BeamResult,
+    pub(crate) light_above: bool,
+    pub(crate) counts: Counts,
 }
 
 /// Work counters of one receiver (or a row of them).
 #[derive(Default, Clone, Copy)]
-struct Counts {
-    rays: u64,
-    traversed: u64,
-    beam_clear: u64,
-    beam_candidates: u64,
-    beam_fallback: u64,
-    unsampled: u64,
+pub(crate) struct Counts {
+    pub(crate) rays: u64,
+    pub(crate) traversed: u64,
+    pub(crate) beam_clear: u64,
+    pub(crate) beam_candidates: u64,
+    pub(crate) beam_fallback: u64,
+    pub(crate) unsampled: u64,
 }
 
 impl Counts {
-    fn add(&mut self, o: &Counts) {
+    pub(crate) fn add(&mut self, o: &Counts) {
         self.rays += o.rays;
         self.traversed += o.traversed;
         self.beam_clear += o.beam_clear;
@@ -97,12 +97,12 @@ impl Counts {
 }
 
 /// What [`Reference`] builds per scene and light.
-struct Prepared {
+pub(crate) struct Prepared {
     quad: Option<[Vec3; 4]>,
     beam_eps: f32,
-    scene: SceneRef,
+    pub(crate) scene: SceneRef,
     semi_opaque: bool,
-    light: Light,
+    pub(crate) light: Light,
     bvh: OcclusionBvh,
     offset: RayOffset,
 }
@@ -121,8 +121,8 @@ pub struct Reference {
 /// The reference prepared for one scene and light: its BVH, ray offsets and light.
 pub struct PreparedReference {
     config: Reference,
-    p: Prepared,
-    stats: Stats,
+    pub(crate) p: Prepared,
+    pub(crate) stats: Stats,
 }
 
 impl std::fmt::Debug for PreparedReference {
@@ -279,7 +279,7 @@ impl Reference {
 
     /// The beam of one receiver (when the light is planar and there are enough samples to
     /// share it): its robust origin and what a traversal of the BVH2 with it found.
-    fn receiver_beam(
+    pub(crate) fn receiver_beam(
         &self,
         p: &Prepared,
         s: &ViewSample,
@@ -322,7 +322,7 @@ impl Reference {
 
     /// Visibility of each light sample from view sample `s` (transmittance in [0, 1]), and the
     /// work done.
-    fn sample_visibility(
+    pub(crate) fn sample_visibility(
         &self,
         p: &Prepared,
         s: &ViewSample,

@@ -53,7 +53,10 @@ pub struct RenderArgs {
     seed: u64,
     /// Also write the direct illumination (DCS eq. 6, diffuse albedo) as `direct.exr` and
     /// `direct.png`: the technique's own, from its per-sample visibility (sample-based
-    /// techniques), or without `--technique` the reference's at `--samples` (default 256).
+    /// techniques), or without `--technique` the reference's at `--samples` (default 256);
+    /// and, for planar lights of constant radiance, the same samples' ratio estimator (the
+    /// closed-form unshadowed light times the visible share, Heitz et al. 2018) as
+    /// `direct-ratio.exr` and `direct-ratio.png`.
     #[arg(long)]
     direct: bool,
     /// Output directory.
@@ -62,7 +65,7 @@ pub struct RenderArgs {
 }
 
 /// Every file a render may write; each run removes them first.
-const OUTPUTS: [&str; 8] = [
+const OUTPUTS: [&str; 10] = [
     "position.exr",
     "normal.exr",
     "stats.json",
@@ -71,6 +74,8 @@ const OUTPUTS: [&str; 8] = [
     "shaded.png",
     "direct.exr",
     "direct.png",
+    "direct-ratio.exr",
+    "direct-ratio.png",
 ];
 
 pub fn run(a: RenderArgs) -> Result<(), String> {
@@ -145,7 +150,7 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         pb.inc(1);
         pb.set_message(format!("{}: estimate", t.name()));
         let outputs = Outputs {
-            per_sample: false,
+            per_sample: a.direct && t.light_sampler().is_some(),
             direct: a.direct,
         };
         let est = prepared
@@ -153,11 +158,16 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
             .map_err(|e| e.to_string())?;
         pb.inc(1);
         if let Some(direct) = &est.direct {
-            write_direct(&a.out, &view, direct)?;
+            write_direct(&a.out, "direct", &view, direct)?;
+            let ratio = match t.light_sampler() {
+                Some(sampler) => write_ratio(&a.out, &setup, &light, sampler, &view, &est)?,
+                None => false,
+            };
             stats["direct_illumination"] = json!({
                 "technique": t.name(),
                 "samples": t.light_sampler().map(|s| s.count()),
                 "seconds": est.stats.phase_seconds("direct"),
+                "ratio_estimator": ratio,
             });
         }
         write_visibility_exr(&a.out.join("visibility.exr"), &est.visibility)
@@ -189,14 +199,27 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
             .map_err(|e| e.to_string())?;
         let t0 = Instant::now();
         let prepared = r
-            .prepare_reference(setup.scene.clone(), light.clone())
+            .prepare(setup.scene.clone(), light.clone())
             .map_err(|e| e.to_string())?;
-        let direct = prepared.direct_illumination(&view);
-        write_direct(&a.out, &view, &direct)?;
+        let outputs = Outputs {
+            per_sample: true,
+            direct: true,
+        };
+        let est = prepared
+            .estimate(&view, outputs)
+            .map_err(|e| e.to_string())?;
+        let direct = est
+            .direct
+            .as_deref()
+            .ok_or("the reference gave no direct light")?;
+        write_direct(&a.out, "direct", &view, direct)?;
+        let sampler = r.light_sampler().ok_or("the reference has no sampler")?;
+        let ratio = write_ratio(&a.out, &setup, &light, sampler, &view, &est)?;
         stats["direct_illumination"] = json!({
             "technique": r.name(),
             "samples": a.samples.unwrap_or(256),
             "seconds": t0.elapsed().as_secs_f64(),
+            "ratio_estimator": ratio,
         });
     }
     pb.finish_and_clear();
@@ -211,14 +234,39 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
     Ok(())
 }
 
-/// Writes direct illumination as `direct.exr` and `direct.png` in `out`.
+/// Writes direct illumination as `STEM.exr` and `STEM.png` in `out`.
 fn write_direct(
     out: &std::path::Path,
+    stem: &str,
     view: &ViewSamples,
     direct: &[glam::Vec3],
 ) -> Result<(), String> {
-    write_rgb_exr(&out.join("direct.exr"), view, direct).map_err(|e| e.to_string())?;
-    write_radiance_png(&out.join("direct.png"), view, direct).map_err(|e| e.to_string())
+    write_rgb_exr(&out.join(format!("{stem}.exr")), view, direct).map_err(|e| e.to_string())?;
+    write_radiance_png(&out.join(format!("{stem}.png")), view, direct).map_err(|e| e.to_string())
+}
+
+/// Writes the ratio estimator of the estimate's per-sample visibility as `direct-ratio.*`;
+/// `false` (and nothing written) for lights without a closed form.
+fn write_ratio(
+    out: &std::path::Path,
+    setup: &SceneSetup,
+    light: &Light,
+    sampler: &LightSampler,
+    view: &ViewSamples,
+    est: &Estimate,
+) -> Result<bool, String> {
+    let ratio = shadow_core::technique::ratio_direct_from_per_sample(
+        setup.scene.as_ref(),
+        light.as_ref(),
+        sampler,
+        view,
+        &est.visibility,
+    )
+    .map_err(|e| e.to_string())?;
+    match ratio {
+        Some(r) => write_direct(out, "direct-ratio", view, &r).map(|()| true),
+        None => Ok(false),
+    }
 }
 
 /// The light to shadow: `chosen`, or the only one; a scene with several lights and no choice is
