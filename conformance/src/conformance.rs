@@ -346,6 +346,18 @@ pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
     let false_shadow = false_shadow_share(&est.visibility, &reference);
     let budget = (preset.budget)(&ctx.setup.name);
     let mut notes = Vec::new();
+    if !est.decision.is_null() {
+        let d = &est.decision;
+        notes.push(format!(
+            "chose {} ({}): predicted RMSE {:.4} in {:.4} s, achieved {:.4} in {:.4} s",
+            d["choice"].as_str().unwrap_or("?"),
+            d["reason"].as_str().unwrap_or("?"),
+            d["predicted"]["rmse"].as_f64().unwrap_or(f64::NAN),
+            d["predicted"]["seconds"].as_f64().unwrap_or(f64::NAN),
+            metrics.rmse,
+            seconds,
+        ));
+    }
     let enforce_max = (cfg.width, cfg.height) == BUDGET_RESOLUTION;
     match &budget {
         Some(b) => check_budget(

@@ -24,6 +24,7 @@
 
 #![deny(missing_docs)]
 
+pub mod auto;
 pub mod closed_form;
 pub mod conformance;
 pub mod stress;
@@ -37,6 +38,7 @@ pub fn registry() -> Vec<Preset> {
     all.extend(shadow_dcs::presets());
     all.extend(shadow_ssm::presets());
     all.extend(shadow_afsm::presets());
+    all.extend(auto::presets());
     all
 }
 

@@ -27,7 +27,6 @@ use std::sync::Arc;
 use glam::{UVec2, Vec3};
 use serde_json::json;
 use shadow_core::gpu::{GpuContext, GpuError, check_finite, gpu_required};
-use shadow_core::light::LightKind;
 use shadow_core::offset::RayOffset;
 use shadow_core::prelude::*;
 use shadow_core::sampling::hash_words;
@@ -727,14 +726,7 @@ impl ShadowTechnique for Afsm {
     }
 
     fn capabilities(&self) -> Capabilities {
-        Capabilities {
-            lights: LightKind::ALL.to_vec(),
-            semi_opaque: true,
-            textured_lights: true,
-            needs_closed_meshes: false,
-            sample_based: !self.hard,
-            processor: Processor::Gpu,
-        }
+        Capabilities::any_input(!self.hard, Processor::Gpu)
     }
 
     fn parameters(&self) -> serde_json::Value {

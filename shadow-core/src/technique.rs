@@ -143,6 +143,20 @@ pub struct Capabilities {
 }
 
 impl Capabilities {
+    /// Every light kind, semi-opaque occluders, textured lights and open meshes: the
+    /// capabilities of a technique that handles any input (ray tracing, AFSM, the `auto`
+    /// chooser).
+    pub fn any_input(sample_based: bool, processor: Processor) -> Self {
+        Self {
+            lights: LightKind::ALL.to_vec(),
+            semi_opaque: true,
+            textured_lights: true,
+            needs_closed_meshes: false,
+            sample_based,
+            processor,
+        }
+    }
+
     /// `Ok` when the technique can handle `scene` lit by `light`, else the reason.
     ///
     /// # Errors
@@ -327,6 +341,10 @@ pub struct Estimate {
     pub direct: Option<Vec<Vec3>>,
     /// Times and counters of this estimate.
     pub stats: Stats,
+    /// What the technique decided at estimate time, for reports (`stats.json`): the `auto`
+    /// chooser's choice, its reason and its prediction. `Null` for techniques that decide
+    /// nothing per view.
+    pub decision: serde_json::Value,
 }
 
 impl Estimate {
@@ -336,6 +354,7 @@ impl Estimate {
             visibility,
             direct: None,
             stats,
+            decision: serde_json::Value::Null,
         }
     }
 }

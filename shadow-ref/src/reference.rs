@@ -28,7 +28,7 @@ use glam::{UVec2, Vec2, Vec3};
 use rayon::prelude::*;
 use serde_json::json;
 use shadow_core::direct::pixel_direct;
-use shadow_core::light::{LightKind, LightSample, PointLight};
+use shadow_core::light::{LightSample, PointLight};
 use shadow_core::prelude::*;
 use shadow_core::sampling::SamplingError;
 
@@ -103,7 +103,8 @@ pub(crate) struct Prepared {
     pub(crate) scene: SceneRef,
     semi_opaque: bool,
     pub(crate) light: Light,
-    bvh: OcclusionBvh,
+    /// Shared between preparations of the same scene ([`Reference::prepare_sharing`]).
+    bvh: Arc<OcclusionBvh>,
     offset: RayOffset,
 }
 
@@ -244,7 +245,7 @@ impl Reference {
             semi_opaque: scene.has_semi_opaque(),
             scene,
             light,
-            bvh,
+            bvh: Arc::new(bvh),
             offset: RayOffset::for_extent(extent),
         };
         Ok(PreparedReference {
@@ -252,6 +253,34 @@ impl Reference {
             p,
             stats,
         })
+    }
+
+    /// This configuration prepared for the scene and light `other` was prepared for, sharing
+    /// its BVH instead of building another (the `auto` chooser runs the reference after a
+    /// probe that built one).
+    pub fn prepare_sharing(&self, other: &PreparedReference) -> PreparedReference {
+        let o = &other.p;
+        let quad = if self.source == SampleSource::Hard {
+            None
+        } else {
+            o.light.geometry().bounding_quad()
+        };
+        let mut stats = Stats::default();
+        stats.add("bvh-shared", 1);
+        stats.add("triangles", o.scene.triangle_count() as u64);
+        PreparedReference {
+            config: self.clone(),
+            p: Prepared {
+                quad,
+                beam_eps: o.beam_eps,
+                scene: o.scene.clone(),
+                semi_opaque: o.semi_opaque,
+                light: o.light.clone(),
+                bvh: o.bvh.clone(),
+                offset: o.offset,
+            },
+            stats,
+        }
     }
 
     /// The light samples of a pixel (the centre alone in hard mode).
@@ -317,6 +346,17 @@ impl Reference {
             mode,
             light_above,
             counts,
+        }
+    }
+
+    /// A receiver's beam known in advance to hold too many candidates: its robust origin and
+    /// the per-segment BVH query, without traversing the beam again.
+    pub(crate) fn receiver_without_beam(&self, p: &Prepared, s: &ViewSample) -> ReceiverBeam {
+        ReceiverBeam {
+            origin: p.offset.offset(s.position, s.geometric_normal),
+            mode: BeamResult::TooMany,
+            light_above: false,
+            counts: Counts::default(),
         }
     }
 
@@ -428,14 +468,7 @@ impl ShadowTechnique for Reference {
     }
 
     fn capabilities(&self) -> Capabilities {
-        Capabilities {
-            lights: LightKind::ALL.to_vec(),
-            semi_opaque: true,
-            textured_lights: true,
-            needs_closed_meshes: false,
-            sample_based: self.source != SampleSource::Stratified,
-            processor: Processor::Cpu,
-        }
+        Capabilities::any_input(self.source != SampleSource::Stratified, Processor::Cpu)
     }
 
     fn parameters(&self) -> serde_json::Value {

@@ -5,8 +5,12 @@
 //! * `conformance`: the main job, every preset on every supported built-in scene, with a report.
 //! * `bench`: run time against error, reference curves and scaling sweeps, CSV/JSON and plots.
 //! * `stress`: the numerical-stability suite against every preset.
+//! * `budgets`: the adaptive reference against the uniform one at equal error, and the ratio
+//!   estimator of direct light against eq. 6.
 
+mod auto_study;
 mod bench;
+mod budgets;
 mod common;
 mod conformance;
 mod overrides;
@@ -39,6 +43,9 @@ enum Command {
     Bench(bench::BenchArgs),
     /// The numerical-stability suite against every preset.
     Stress(stress::StressArgs),
+    /// The adaptive reference against the uniform one at equal error; the ratio estimator of
+    /// direct light against eq. 6 at equal samples.
+    Budgets(budgets::BudgetsArgs),
 }
 
 /// Marks a process that [`quiet_headless_vulkan`] started, so it never starts another.
@@ -87,6 +94,7 @@ fn main() -> ExitCode {
         Command::Conformance(a) => conformance::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Stress(a) => stress::run(a),
+        Command::Budgets(a) => budgets::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

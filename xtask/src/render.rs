@@ -27,6 +27,14 @@ pub struct RenderArgs {
     /// Samples per pixel, for presets with a sample count.
     #[arg(long)]
     samples: Option<u32>,
+    /// With `--technique auto`: the image RMSE to meet (against an independent many-sample
+    /// reference).
+    #[arg(long)]
+    rmse: Option<f64>,
+    /// With `--technique auto`: the seconds to fit in (preparation and estimate, the chooser's
+    /// probe included).
+    #[arg(long)]
+    seconds: Option<f64>,
     /// Image width.
     #[arg(long, default_value_t = 512)]
     width: u32,
@@ -90,8 +98,14 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         setup.camera = Some(crate::overrides::camera(spec)?);
         setup.aspect = None;
     }
-    let technique = match &a.technique {
-        Some(t) => Some(resolve_technique(t, a.samples, a.seed)?),
+    let technique = match a.technique.as_deref() {
+        Some("auto") => Some(auto_technique(&a)?),
+        Some(t) => {
+            if a.rmse.is_some() || a.seconds.is_some() {
+                return Err("--rmse and --seconds go with --technique auto".into());
+            }
+            Some(resolve_technique(t, a.samples, a.seed)?)
+        }
         None => None,
     };
     if a.technique.is_none() && a.samples.is_some() && !a.direct {
@@ -189,6 +203,11 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
             serde_json::to_value(prepared.preparation()).map_err(|e| e.to_string())?;
         stats["estimate"] = serde_json::to_value(&est.stats).map_err(|e| e.to_string())?;
         stats["classes"] = json!(est.visibility.class_counts());
+        if !est.decision.is_null() {
+            let mut d = est.decision.clone();
+            d["achieved_seconds"] = json!(est.stats.total_seconds());
+            stats["decision"] = d;
+        }
         if let Some(r) = rays_per_second_per_thread(&est.stats) {
             stats["occlusion_rays_per_second_per_thread"] = json!(r);
         }
@@ -232,6 +251,22 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         view.valid_count()
     );
     Ok(())
+}
+
+/// The `auto` chooser under the budget `--rmse` or `--seconds` names (exactly one).
+fn auto_technique(a: &RenderArgs) -> Result<Box<dyn ShadowTechnique>, String> {
+    use shadow_conformance::auto::{Auto, AutoBudget};
+    if a.samples.is_some() {
+        return Err("`auto` chooses its own sample count: give --rmse or --seconds".into());
+    }
+    let budget = match (a.rmse, a.seconds) {
+        (Some(r), None) => AutoBudget::Rmse(r),
+        (None, Some(s)) => AutoBudget::Seconds(s),
+        _ => return Err("--technique auto needs exactly one of --rmse and --seconds".into()),
+    };
+    Ok(Box::new(
+        Auto::new(budget, a.seed).map_err(|e| e.to_string())?,
+    ))
 }
 
 /// Writes direct illumination as `STEM.exr` and `STEM.png` in `out`.

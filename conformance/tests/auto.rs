@@ -1,0 +1,121 @@
+//! The `auto` chooser on built-in scenes: it meets an RMSE budget (with a looser bound than
+//! the budgets study's, at a small size), records its choice and prediction, is deterministic
+//! under an error budget whatever the thread count, gives the outputs asked for, picks the
+//! fastest prediction when nothing fits a time budget, and refuses bad budgets.
+
+use shadow_conformance::auto::{Auto, AutoBudget};
+use shadow_core::metrics::compare;
+use shadow_core::prelude::*;
+use shadow_core::scenes::builtin;
+use shadow_ref::Reference;
+
+fn view_of(setup: &SceneSetup, w: u32, h: u32) -> ViewSamples {
+    ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), w, h).unwrap()
+}
+
+fn run(t: &dyn ShadowTechnique, setup: &SceneSetup, view: &ViewSamples, o: Outputs) -> Estimate {
+    t.prepare(setup.scene.clone(), setup.lights[0].clone())
+        .unwrap()
+        .estimate(view, o)
+        .unwrap()
+}
+
+#[test]
+fn auto_meets_rmse_budgets_and_says_what_it_chose() {
+    for scene in ["quad-over-plane", "bunny", "semi-opaque", "sphere-light"] {
+        let setup = builtin(scene).unwrap();
+        let view = view_of(&setup, 64, 48);
+        let truth = run(
+            &Reference::stratified(4096, 0xfeed).unwrap(),
+            &setup,
+            &view,
+            Outputs::VISIBILITY,
+        );
+        for budget in [0.03, 0.01] {
+            let auto = Auto::new(AutoBudget::Rmse(budget), 1).unwrap();
+            let e = run(&auto, &setup, &view, Outputs::VISIBILITY);
+            let rmse = compare(&e.visibility, &truth.visibility).unwrap().rmse;
+            let choice = e.decision["choice"].as_str().unwrap();
+            assert!(
+                rmse <= 1.5 * budget + 0.002,
+                "{scene} RMSE budget {budget}: {choice} gave {rmse}"
+            );
+            let predicted = e.decision["predicted"]["rmse"].as_f64().unwrap();
+            assert!(predicted.is_finite() && predicted >= 0.0);
+            assert!(e.stats.counter("auto-candidates").unwrap() > 0);
+            assert!(e.stats.phase_seconds("auto-probe").is_some());
+        }
+    }
+}
+
+#[test]
+fn auto_under_an_error_budget_is_deterministic_whatever_the_thread_count() {
+    let setup = builtin("overlapping-occluders").unwrap();
+    let view = view_of(&setup, 48, 36);
+    let auto = Auto::new(AutoBudget::Rmse(0.01), 7).unwrap();
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let a = one.install(|| run(&auto, &setup, &view, Outputs::VISIBILITY));
+    let b = run(&auto, &setup, &view, Outputs::VISIBILITY);
+    assert_eq!(a.decision["choice"], b.decision["choice"]);
+    assert_eq!(a.visibility.coefficients(), b.visibility.coefficients());
+}
+
+#[test]
+fn auto_gives_the_outputs_asked_for() {
+    let setup = builtin("bunny").unwrap();
+    let view = view_of(&setup, 32, 24);
+    let auto = Auto::new(AutoBudget::Rmse(0.03), 1).unwrap();
+    let direct = Outputs {
+        per_sample: false,
+        direct: true,
+    };
+    assert!(run(&auto, &setup, &view, direct).direct.is_some());
+    let e = run(&auto, &setup, &view, Outputs::PER_SAMPLE);
+    assert!(e.visibility.per_sample().is_some());
+}
+
+#[test]
+fn nothing_fits_a_tiny_time_budget_so_auto_takes_the_fastest_prediction() {
+    let setup = builtin("contact").unwrap();
+    let view = view_of(&setup, 48, 36);
+    let auto = Auto::new(AutoBudget::Seconds(1e-9), 1).unwrap();
+    let e = run(&auto, &setup, &view, Outputs::VISIBILITY);
+    let fastest = e.decision["candidates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .min_by(|a, b| {
+            a["seconds"]
+                .as_f64()
+                .unwrap()
+                .total_cmp(&b["seconds"].as_f64().unwrap())
+        })
+        .unwrap()["name"]
+        .clone();
+    assert_eq!(e.decision["choice"], fastest);
+    assert!(
+        e.decision["reason"]
+            .as_str()
+            .unwrap()
+            .contains("the fastest")
+    );
+}
+
+#[test]
+fn bad_budgets_are_errors() {
+    for b in [
+        AutoBudget::Rmse(0.0),
+        AutoBudget::Rmse(1.0),
+        AutoBudget::Rmse(f64::NAN),
+        AutoBudget::Seconds(-1.0),
+        AutoBudget::Seconds(f64::INFINITY),
+    ] {
+        assert!(
+            matches!(Auto::new(b, 1), Err(TechniqueError::InvalidInput(_))),
+            "{b:?}"
+        );
+    }
+}
