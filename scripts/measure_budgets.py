@@ -16,6 +16,9 @@ def main() -> None:
     path, pairs = sys.argv[1], dict(a.split("=") for a in sys.argv[2:])
     rows = {}
     for line in sys.stdin:
+        # With one test thread libtest prints `test NAME ... ` before the case's own line.
+        if line.startswith("test ") and " ... " in line:
+            line = line.split(" ... ", 1)[1]
         t = line.split()
         if len(t) < 12 or t[2] != "rmse":
             continue
