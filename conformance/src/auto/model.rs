@@ -18,9 +18,10 @@
 //! fitting scenes, so the prediction errs on the safe side.
 //!
 //! **Cost** in seconds on the fitting machine: `theta . [triangles, pixels, sampled pixels,
-//! penumbra pixels]` with `theta >= 0`, fitted by non-negative least squares on relative
-//! errors (every subset of the four terms, the best feasible one kept). The probe's own cost
-//! is fitted the same way; at run time the ratio of the probe's measured time to its
+//! penumbra pixels, silhouette edges x penumbra pixels, sampled pixels x v16^(2/3)]` with
+//! `theta >= 0`, fitted by non-negative least squares on relative errors (every subset of the
+//! terms the configuration's work can depend on, [`Config::cost_mask`], the best feasible one
+//! kept). The probe's own cost is fitted the same way on the first four terms; at run time the ratio of the probe's measured time to its
 //! predicted time scales every prediction to the machine at hand. The ratio is common to all
 //! candidates, so under an error budget the choice does not depend on it: it is deterministic.
 
@@ -59,6 +60,20 @@ pub enum Config {
 }
 
 impl Config {
+    /// The cost terms ([`COST_TERMS`], as a bit mask) the configuration's cost may depend on:
+    /// triangles, pixels, sampled and penumbra pixels for all; the silhouette term for DCS
+    /// alone (its wedges); the `v16` term for the adaptive reference alone (its counts follow
+    /// the variance). A term a configuration's work cannot depend on is never fitted, so a
+    /// correlation between scenes cannot stand in for a cost.
+    pub fn cost_mask(&self) -> u32 {
+        const BASE: u32 = 0b1111;
+        match self {
+            Config::Dcs { .. } => BASE | 1 << 4,
+            Config::RefAdaptive { .. } => BASE | 1 << 5,
+            Config::Ref { .. } | Config::Preset { .. } => BASE,
+        }
+    }
+
     /// Whether the configuration's error on semi-opaque occluders is only sampling noise. DCS
     /// sums opacities (a saturating count of layers, DCS section 3) where the exact answer is
     /// the product of transmittances: its error there has a floor that no sample count lowers
@@ -277,7 +292,7 @@ impl AutoModel {
                     .map(|o| (o.features.terms(), o.seconds))
                     .collect();
                 Candidate {
-                    cost: nnls_relative(&rows),
+                    cost: nnls_relative(&rows, config.cost_mask()),
                     error,
                     scenes: runs.len(),
                     config,
@@ -292,7 +307,8 @@ impl AutoModel {
             fitted,
             probe_pixels,
             error_quantile,
-            probe_cost: nnls_relative(&probe_rows),
+            // The probe is the adaptive reference's first pass: BVH, beams, 32 samples.
+            probe_cost: nnls_relative(&probe_rows, PROBE_COST_MASK),
             candidates,
         }
     }
@@ -337,17 +353,20 @@ pub fn quantile(mut v: Vec<f64>, q: f64) -> Option<f64> {
     Some(v[i])
 }
 
+/// The cost terms the probe's own time may depend on (see [`Config::cost_mask`]).
+pub const PROBE_COST_MASK: u32 = 0b1111;
+
 /// Non-negative least squares on relative errors: `theta >= 0` minimising
-/// `sum ((theta . x - t) / t)^2`, by trying every subset of the terms (there are four) and
-/// keeping the feasible solution of least residual.
-pub fn nnls_relative(rows: &[([f64; COST_TERMS], f64)]) -> [f64; COST_TERMS] {
+/// `sum ((theta . x - t) / t)^2` over the terms in `allowed` (a bit mask), by trying every
+/// subset of them and keeping the feasible solution of least residual.
+pub fn nnls_relative(rows: &[([f64; COST_TERMS], f64)], allowed: u32) -> [f64; COST_TERMS] {
     let rows: Vec<([f64; COST_TERMS], f64)> = rows
         .iter()
         .filter(|(_, t)| *t > 0.0 && t.is_finite())
         .map(|(x, t)| (x.map(|v| v / t), 1.0))
         .collect();
     let mut best = ([0.0; COST_TERMS], f64::INFINITY);
-    for mask in 1u32..(1 << COST_TERMS) {
+    for mask in (1u32..(1 << COST_TERMS)).filter(|m| m & !allowed == 0) {
         let idx: Vec<usize> = (0..COST_TERMS).filter(|i| mask & (1 << i) != 0).collect();
         if idx.len() > rows.len() {
             continue;
@@ -429,11 +448,14 @@ mod tests {
         .iter()
         .map(|x| (*x, dot(&theta, x)))
         .collect();
-        let fit = nnls_relative(&rows);
+        let fit = nnls_relative(&rows, (1 << COST_TERMS) - 1);
         for (x, t) in &rows {
             assert!((dot(&fit, x) - t).abs() < 1e-6 * t, "{fit:?}");
         }
         assert!(fit.iter().all(|&v| v >= 0.0));
+        // Terms outside the mask stay at zero.
+        let masked = nnls_relative(&rows, 0b1011);
+        assert_eq!((masked[2], masked[4], masked[5]), (0.0, 0.0, 0.0));
     }
 
     #[test]
