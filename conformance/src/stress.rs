@@ -122,6 +122,10 @@ fn camera(eye: Vec3, target: Vec3) -> Camera {
     Camera::look_at(eye, target, Vec3::Y, 0.9).expect("valid camera")
 }
 
+fn q_floor() -> f32 {
+    shadow_core::scenes::quad_over_plane::FLOOR_SIDE
+}
+
 fn mesh(m: (Vec<Vec3>, Vec<[u32; 3]>)) -> MeshDesc {
     MeshDesc::new(m.0, m.1)
 }
@@ -248,6 +252,55 @@ pub fn technique_cases(preset: &Preset, width: u32, height: u32) -> Vec<StressRe
                     name,
                     e <= invariance,
                     format!("rmse against the unscaled scene {e:.5} (tolerance {invariance})"),
+                )
+            }
+            (Err(e), _) => result(label, name, false, e.clone()),
+            (_, Err(e)) => result(label, name, false, e),
+        };
+        out.push(r);
+    }
+    // Issue 51 item 5: what else the scene holds must not move the receivers' shadow rays: a
+    // 200 km floor, or one far triangle, against the same occluder and light.
+    let quad_scene = |floor_side: f32, far: bool| {
+        use shadow_core::scenes::quad_over_plane as q;
+        let mut meshes = vec![
+            mesh(floor(floor_side, 0.0)),
+            mesh(quad(
+                Vec3::new(0.0, q::OCCLUDER_HEIGHT, 0.0),
+                Vec3::new(0.5 * q::OCCLUDER_SIDE, 0.0, 0.0),
+                Vec3::new(0.0, 0.0, -0.5 * q::OCCLUDER_SIDE),
+            )),
+        ];
+        if far {
+            meshes.push(mesh(quad(
+                Vec3::new(3e4, 0.0, -4e4),
+                Vec3::new(0.1, 0.0, 0.0),
+                Vec3::new(0.0, 0.1, 0.0),
+            )));
+        }
+        let mut s = setup_of(
+            "extent",
+            meshes,
+            base.lights[0].clone(),
+            base.camera_or_default(),
+        );
+        s.name = format!("floor {floor_side}, far triangle {far}");
+        s
+    };
+    let small = quad_scene(q_floor(), false);
+    let small_out = run_on(preset, &small, &view_of(&small), 3);
+    for (label, setup) in [
+        ("huge-floor", quad_scene(2e5, false)),
+        ("far-triangle", quad_scene(q_floor(), true)),
+    ] {
+        let r = match (&small_out, run_on(preset, &setup, &view_of(&setup), 3)) {
+            (Ok((a, ..)), Ok((b, ..))) => {
+                let e = rmse_common(a, &b);
+                result(
+                    label,
+                    name,
+                    e <= invariance,
+                    format!("rmse against the 6 m floor alone {e:.5} (tolerance {invariance})"),
                 )
             }
             (Err(e), _) => result(label, name, false, e.clone()),

@@ -425,14 +425,14 @@ impl Afsm {
             ))
         };
         let (samples, radiance, lut) = up().map_err(device_error)?;
-        let extent = scene.bounds().diagonal();
+        let offset = RayOffset::for_light(&*light);
         Ok(Prepared {
             scene,
             light,
             gpu,
             pipes,
             bounds,
-            offset: RayOffset::for_extent(extent),
+            offset,
             batches,
             around_light,
             closed,

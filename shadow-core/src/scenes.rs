@@ -375,6 +375,42 @@ pub fn transformed(
     scale: f32,
     translation: Vec3,
 ) -> Result<SceneSetup, BuiltinError> {
+    let mut out = moved(setup, scale, translation, Some(1e-4 * scale.max(1e-30)))?;
+    out.name = format!("{}@scale={scale:e},translate={}", setup.name, translation);
+    Ok(out)
+}
+
+/// `setup` moved so that its bounds' centre is at the origin, and the shift that was added to
+/// every position (scene, lights, camera), when the scene sits farther from the origin than its
+/// own size; otherwise `None`.
+///
+/// Every technique works in the scene's single-precision coordinates, whose spacing grows with
+/// their magnitude: a 10 m room at 1e6 m from the origin has positions 6 cm apart and shadow-ray
+/// origins that must move a quarter metre to clear their own rounding, so contact shadows and
+/// small occluders vanish (issue 51 item 11). Subtracting the centre keeps the stored geometry
+/// (the difference of two nearby floats is exact or rounded at the small result's spacing) and
+/// gives back every bit of precision the scene's size allows. Renderers call this once after
+/// loading and add the shift back to any world position they output.
+///
+/// # Errors
+/// [`BuiltinError`] when a moved light or camera is invalid.
+pub fn recentred(setup: &SceneSetup) -> Result<Option<(SceneSetup, Vec3)>, BuiltinError> {
+    use crate::scene::Scene;
+    let b = setup.scene.bounds();
+    let c = b.center();
+    if !c.is_finite() || c.abs().max_element() <= b.diagonal() {
+        return Ok(None);
+    }
+    let near = setup.camera.map(|cam| cam.near());
+    Ok(Some((moved(setup, 1.0, -c, near)?, -c)))
+}
+
+fn moved(
+    setup: &SceneSetup,
+    scale: f32,
+    translation: Vec3,
+    near: Option<f32>,
+) -> Result<SceneSetup, BuiltinError> {
     let t = Affine3A::from_translation(translation) * Affine3A::from_scale(Vec3::splat(scale));
     let scene = setup.scene.transformed(t).map_err(LoadError::from)?;
     let lights = setup
@@ -391,17 +427,16 @@ pub fn transformed(
                 w.matrix3.z_axis,
                 (Vec3::from(w.translation) * scale + translation).into(),
             );
-            Some(
-                Camera::from_world_transform(moved, c.yfov())
-                    .map_err(LoadError::from)?
-                    .with_near(1e-4 * scale.max(1e-30))
-                    .map_err(LoadError::from)?,
-            )
+            let cam = Camera::from_world_transform(moved, c.yfov()).map_err(LoadError::from)?;
+            Some(match near {
+                Some(n) => cam.with_near(n).map_err(LoadError::from)?,
+                None => cam,
+            })
         }
         None => None,
     };
     Ok(SceneSetup {
-        name: format!("{}@scale={scale:e},translate={}", setup.name, translation),
+        name: setup.name.clone(),
         scene: Arc::new(scene),
         lights,
         camera,

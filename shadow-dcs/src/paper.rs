@@ -112,8 +112,7 @@ pub fn paper_depth_complexity(
     let (edges, units) = scene_edges(scene, c);
     let sil = silhouettes(&edges, &shape, detection);
     // The view samples' origins, offset off their surfaces as the reference's are.
-    let extent = scene.bounds().union(light.bounds()).diagonal();
-    let offset = RayOffset::for_extent(extent);
+    let offset = RayOffset::for_light(light);
     let n = view.len();
     let origins: Vec<Vec3> = (0..n)
         .map(|i| {

@@ -172,7 +172,7 @@ fn remaining_disagreements_are_numerical_ties() {
     let light = setup.lights[0].as_ref();
     let sampler = dcs.light_sampler().unwrap();
     let extent = scene.bounds().union(light.bounds()).diagonal();
-    let offset = shadow_core::offset::RayOffset::for_extent(extent);
+    let offset = shadow_core::offset::RayOffset::for_light(light);
     let (mut pairs, mut differ) = (0u64, 0u64);
     let mut units = Vec::new();
     for i in 0..view.len() {

@@ -23,6 +23,22 @@ pub struct Beam {
 }
 
 impl Beam {
+    /// The plane-test slack for the pyramid from `apex` to `base`: the rounding of its planes'
+    /// normals and offsets, relative to the largest coordinate involved and to the pyramid's
+    /// length. It follows the beam, not the scene (a 200 km floor elsewhere must not widen it
+    /// past the receivers' ray offsets, issue 51 item 5), and stays below the offset that puts
+    /// the apex above its own surface ([`shadow_core::offset::RayOffset`]), so the receiver's
+    /// coplanar neighbours are culled. A larger slack would only cost speed: the cull stays
+    /// conservative and the candidates get the exact test.
+    pub fn rounding_slack(apex: Vec3, base: &[Vec3; 4]) -> f32 {
+        let coord = base
+            .iter()
+            .fold(apex.abs(), |m, q| m.max(q.abs()))
+            .max_element();
+        let length = base.iter().map(|q| q.distance(apex)).fold(0.0f32, f32::max);
+        8.0 * f32::EPSILON * (coord + length)
+    }
+
     /// The pyramid from `apex` to the convex quad `base` (corners in order). `eps` is the
     /// distance slack of every plane test (use a small multiple of the scene's float precision).
     /// `None` when the pyramid is degenerate (apex on the base plane).

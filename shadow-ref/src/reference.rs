@@ -99,7 +99,6 @@ impl Counts {
 /// What [`Reference`] builds per scene and light.
 pub(crate) struct Prepared {
     quad: Option<[Vec3; 4]>,
-    beam_eps: f32,
     pub(crate) scene: SceneRef,
     semi_opaque: bool,
     pub(crate) light: Light,
@@ -223,7 +222,6 @@ impl Reference {
         let mut stats = Stats::default();
         let bvh = stats.time("bvh-build", || OcclusionBvh::build(scene.as_ref()));
         stats.add("triangles", scene.triangle_count() as u64);
-        let extent = scene.bounds().union(light.bounds()).diagonal();
         let light: Light = if light.area() == 0.0 {
             Arc::new(
                 PointLight::new(light.center(), light.radiance().clone())
@@ -232,21 +230,19 @@ impl Reference {
         } else {
             light
         };
-        let bounds = scene.bounds().union(light.bounds());
-        let coord = bounds.min.abs().max(bounds.max.abs()).max_element();
         let quad = if self.source == SampleSource::Hard {
             None
         } else {
             light.geometry().bounding_quad()
         };
+        let offset = RayOffset::for_light(&*light);
         let p = Prepared {
             quad,
-            beam_eps: 1e-5 * extent.max(f32::MIN_POSITIVE) + 8.0 * f32::EPSILON * coord,
             semi_opaque: scene.has_semi_opaque(),
             scene,
             light,
             bvh: Arc::new(bvh),
-            offset: RayOffset::for_extent(extent),
+            offset,
         };
         Ok(PreparedReference {
             config: self.clone(),
@@ -272,7 +268,6 @@ impl Reference {
             config: self.clone(),
             p: Prepared {
                 quad,
-                beam_eps: o.beam_eps,
                 scene: o.scene.clone(),
                 semi_opaque: o.semi_opaque,
                 light: o.light.clone(),
@@ -318,7 +313,9 @@ impl Reference {
         let origin = p.offset.offset(s.position, s.geometric_normal);
         let mut counts = Counts::default();
         let beam = match p.quad {
-            Some(q) if self.beam && samples >= BEAM_MIN_SAMPLES => Beam::new(origin, q, p.beam_eps),
+            Some(q) if self.beam && samples >= BEAM_MIN_SAMPLES => {
+                Beam::new(origin, q, Beam::rounding_slack(origin, &q))
+            }
             _ => None,
         };
         let mode = match beam {

@@ -387,13 +387,14 @@ impl ShadowTechnique for ShadowMapFilter {
             LightFrame::new(light.as_ref(), &self.name)
         })?;
         let extent = scene.bounds().union(light.bounds()).diagonal();
+        let offset = RayOffset::for_light(&*light);
         Ok(Box::new(PreparedFilter {
             config: self.clone(),
             p: Prepared {
                 scene,
                 light,
                 frame,
-                offset: RayOffset::for_extent(extent),
+                offset,
                 extent,
             },
             stats,

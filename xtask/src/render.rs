@@ -4,6 +4,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
+use glam::Vec3;
 use serde_json::json;
 use shadow_core::image_io::{
     write_normal_exr, write_position_exr, write_radiance_png, write_rgb_exr, write_shaded_png,
@@ -111,6 +112,13 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
     if a.technique.is_none() && a.samples.is_some() && !a.direct {
         return Err("--samples needs --technique or --direct".into());
     }
+    // Far from the origin, work where single precision is dense (issue 51 item 11); positions
+    // are written back in the file's coordinates.
+    let mut shift = Vec3::ZERO;
+    if let Some((moved, by)) = shadow_core::scenes::recentred(&setup).map_err(|e| e.to_string())? {
+        setup = moved;
+        shift = by;
+    }
     let light_index = choose_light(&setup, a.light_index)?;
     let light = setup.lights[light_index].clone();
     let height = a.height.unwrap_or_else(|| match setup.aspect {
@@ -139,7 +147,12 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         ));
     }
     pb.inc(1);
-    write_position_exr(&a.out.join("position.exr"), &view).map_err(|e| e.to_string())?;
+    if shift == Vec3::ZERO {
+        write_position_exr(&a.out.join("position.exr"), &view).map_err(|e| e.to_string())?;
+    } else {
+        let file: Vec<Vec3> = view.positions().iter().map(|p| *p - shift).collect();
+        write_rgb_exr(&a.out.join("position.exr"), &view, &file).map_err(|e| e.to_string())?;
+    }
     write_normal_exr(&a.out.join("normal.exr"), &view).map_err(|e| e.to_string())?;
     pb.inc(1);
     let mut stats = json!({
@@ -154,6 +167,7 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         "threads": rayon::current_num_threads(),
         "gpu_adapter": serde_json::Value::Null,
         "view_samples_seconds": view_seconds,
+        "recentred_by": (shift != Vec3::ZERO).then(|| shift.to_array()),
         "machine": machine(),
     });
     if let Some(t) = technique.as_ref() {

@@ -634,3 +634,86 @@ fn a_command_line_light_and_camera_match_the_scene_built_in_code() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Issue 51 item 11: a scene a million metres from the origin renders as it does at the origin
+/// (the coordinates below are exact at both places); without recentring, shadow-ray origins
+/// moved a quarter metre to clear their own rounding and the occluder's shadow shrank.
+#[test]
+fn a_scene_far_from_the_origin_keeps_its_shadow() {
+    let dir = temp_dir("far-origin");
+    std::fs::create_dir_all(&dir).unwrap();
+    let render = |shift: f64, name: &str| {
+        let obj = dir.join(format!("{name}.obj"));
+        let v = |x: f64, y: f64, z: f64| format!("v {} {} {}\n", x + shift, y + shift, z + shift);
+        let mut text = String::new();
+        for (x, y, z) in [
+            (-2.0, 0.0, -2.0),
+            (2.0, 0.0, -2.0),
+            (2.0, 0.0, 2.0),
+            (-2.0, 0.0, 2.0),
+        ] {
+            text += &v(x, y, z);
+        }
+        for (x, y, z) in [
+            (-0.5, 0.25, -0.5),
+            (0.5, 0.25, -0.5),
+            (0.5, 0.25, 0.5),
+            (-0.5, 0.25, 0.5),
+        ] {
+            text += &v(x, y, z);
+        }
+        text += "f 1 4 3 2\nf 5 8 7 6\n";
+        std::fs::write(&obj, text).unwrap();
+        let at = |x: f64, y: f64, z: f64| format!("{},{},{}", x + shift, y + shift, z + shift);
+        let out_dir = dir.join(name);
+        let out = xtask(&[
+            "render",
+            "--scene",
+            obj.to_str().unwrap(),
+            "--light",
+            &format!("rect:{}:0,-1,0:1.25x0.75", at(0.25, 1.5, 0.125)),
+            "--camera",
+            &format!("{}:{}:40", at(0.0, 3.0, 5.0), at(0.0, 0.0, 0.0)),
+            "--technique",
+            "ref-16",
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let vis = image::open(out_dir.join("visibility.exr"))
+            .unwrap()
+            .to_rgba32f();
+        let pos = image::open(out_dir.join("position.exr"))
+            .unwrap()
+            .to_rgba32f();
+        (vis, pos)
+    };
+    let (near, _) = render(0.0, "near");
+    let (far, far_pos) = render(1e6, "far");
+    let (mut n, mut sq, mut shadowed) = (0, 0.0, 0);
+    for (a, b) in near.pixels().zip(far.pixels()) {
+        if a.0[3] == 1.0 && b.0[3] == 1.0 {
+            n += 1;
+            sq += ((a.0[0] - b.0[0]) as f64).powi(2);
+            shadowed += (a.0[0] < 0.5) as u32;
+        }
+    }
+    let rmse = (sq / n as f64).sqrt();
+    assert!(n > 200 && shadowed > 10, "{n} valid, {shadowed} shadowed");
+    assert!(
+        rmse < 0.01,
+        "rmse between the far and the near scene {rmse}"
+    );
+    // Positions come out in the file's coordinates.
+    let p = far_pos.pixels().find(|p| p.0[3] == 1.0).unwrap();
+    assert!((p.0[1] - 1e6).abs() < 1.0, "{:?}", p.0);
+    std::fs::remove_dir_all(&dir).ok();
+}

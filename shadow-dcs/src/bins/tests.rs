@@ -227,7 +227,7 @@ fn the_hierarchy_finds_every_pair_of_the_brute_force_scan() {
             scan.len()
         );
         let extent = scene.bounds().union(light.bounds()).diagonal();
-        let offset = RayOffset::for_extent(extent);
+        let offset = RayOffset::for_light(light);
         let c = shape.center.as_dvec3();
         let n = view.len();
         let (mut origins, mut centred, mut active) =

@@ -307,6 +307,7 @@ impl Dcs {
                 ScanWedge::new(w, pe)
             })
             .unzip();
+        let offset = RayOffset::for_light(&*light);
         let p = Prepared {
             planar,
             rect,
@@ -320,7 +321,7 @@ impl Dcs {
             edges,
             silhouettes: sil,
             units,
-            offset: RayOffset::for_extent(extent),
+            offset,
             extent: extent as f64,
             tables,
         };
