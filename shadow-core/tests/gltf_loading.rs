@@ -683,3 +683,60 @@ fn ignored_material_data_is_named_in_a_note() {
     let plain = load(&test_document()).unwrap();
     assert!(plain.warnings.is_empty(), "{:?}", plain.warnings);
 }
+
+/// Issue 51 item 17: truncated files said "could not completely read the object"; a GLB or a
+/// JSON cut anywhere now says that the file is truncated.
+#[test]
+fn truncated_files_say_they_are_truncated() {
+    let limits = LoadLimits::default();
+    let doc = test_document();
+    let text = doc.to_string();
+    let glb = make_glb(&text, b"");
+    for cut in [13, 40, glb.len() / 2, glb.len() - 1] {
+        let e = load_gltf_slice(&glb[..cut], None, "cut", &limits).unwrap_err();
+        assert!(e.to_string().contains("truncated"), "GLB cut at {cut}: {e}");
+    }
+    for cut in [1, text.len() / 3, text.len() - 1] {
+        let e = load_gltf_slice(&text.as_bytes()[..cut], None, "cut", &limits).unwrap_err();
+        assert!(
+            e.to_string().contains("truncated"),
+            "JSON cut at {cut}: {e}"
+        );
+    }
+}
+
+/// Issue 51 item 17: a legal hierarchy deeper than 256 nodes was refused; cycles and nodes
+/// with two parents are refused by name.
+#[test]
+fn deep_hierarchies_load_and_cycles_are_named() {
+    let mut doc = test_document();
+    // Nodes 0..7 as written, then a chain of 1000 empty nodes under node 7 ending in the floor.
+    let base = doc["nodes"].as_array().unwrap().len();
+    let chain = 1000;
+    let mut nodes = doc["nodes"].as_array().unwrap().clone();
+    for k in 0..chain {
+        let mut n = json!({"translation": [0.0, 0.0, 0.0]});
+        if k + 1 < chain {
+            n["children"] = json!([base + k + 1]);
+        } else {
+            n["mesh"] = json!(0);
+        }
+        nodes.push(n);
+    }
+    doc["nodes"] = json!(nodes);
+    doc["scenes"][0]["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!(base));
+    let deep = load(&doc).unwrap();
+    assert_eq!(
+        deep.scene.triangle_count(),
+        8,
+        "the floor twice, the rest once"
+    );
+    // A cycle: the chain's last node points back to its first.
+    let mut cyclic = doc.clone();
+    cyclic["nodes"][base + chain - 1]["children"] = json!([base]);
+    let e = load(&cyclic).unwrap_err();
+    assert!(e.to_string().contains("reached twice"), "{e}");
+}

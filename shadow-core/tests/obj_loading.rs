@@ -75,3 +75,17 @@ fn malformed_obj_gives_errors() {
         Err(LoadError::Limit { .. })
     ));
 }
+
+/// Issue 51 item 17: OBJ errors gave no line number.
+#[test]
+fn obj_errors_name_the_line() {
+    for (text, line) in [
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", 4),
+        ("v 0 0 0\n# c\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", 5),
+        ("v 0 0 0\nv 0 0 zz\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", 2),
+        ("v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n", 3),
+    ] {
+        let e = load(text).unwrap_err().to_string();
+        assert!(e.contains(&format!("line {line}:")), "{text:?}: {e}");
+    }
+}

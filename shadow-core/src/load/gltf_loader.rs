@@ -43,11 +43,28 @@ pub fn load_gltf_slice(
     name: &str,
     limits: &LoadLimits,
 ) -> Result<SceneSetup, LoadError> {
+    // A GLB shorter than its header's length is a truncated file: say so before the parser
+    // reports which chunk it could not read.
+    if bytes.starts_with(b"glTF") && bytes.len() >= 12 {
+        let declared = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize;
+        if declared > bytes.len() {
+            return Err(LoadError::Gltf(format!(
+                "the GLB header declares {declared} bytes but the file holds {}: the file is \
+                 truncated",
+                bytes.len()
+            )));
+        }
+    }
     let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| {
         // Neither a GLB (magic `glTF`) nor a JSON object: say so, not what the JSON parser met.
         let json_like = bytes.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'{');
-        if bytes.starts_with(b"glTF") || json_like {
-            LoadError::Gltf(e.to_string())
+        let text = e.to_string();
+        if json_like && text.contains("EOF") {
+            LoadError::Gltf(format!(
+                "the glTF JSON ends before it is complete: the file is truncated ({text})"
+            ))
+        } else if bytes.starts_with(b"glTF") || json_like {
+            LoadError::Gltf(text)
         } else {
             LoadError::Gltf(format!(
                 "not a glTF file: neither GLB (magic `glTF`) nor a JSON object ({e})"
@@ -95,13 +112,20 @@ pub fn load_gltf_slice(
         .rev()
         .map(|n| (n, Mat4::IDENTITY, 0))
         .collect();
-    let mut visited = 0usize;
+    // glTF node hierarchies are disjoint strict trees: a node reached twice is a cycle, or a
+    // node with two parents, and is refused by name. Depth itself is not limited (the walk
+    // uses this explicit stack, not recursion).
+    let mut reached = vec![false; doc.nodes().len()];
     while let Some((node, parent, depth)) = stack.pop() {
-        visited += 1;
-        if depth > 256 || visited > doc.nodes().len() * 4 + 16 {
-            return Err(LoadError::Gltf(
-                "node hierarchy is too deep or cyclic".into(),
-            ));
+        let seen = reached
+            .get_mut(node.index())
+            .map(|r| std::mem::replace(r, true));
+        if seen != Some(false) {
+            return Err(LoadError::Gltf(format!(
+                "node {} is reached twice (at depth {depth}): the node hierarchy has a cycle or \
+                 a node with two parents, where glTF requires disjoint trees",
+                node.index()
+            )));
         }
         let local = Mat4::from_cols_array_2d(&node.transform().matrix());
         let world = parent * local;

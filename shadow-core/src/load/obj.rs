@@ -67,7 +67,7 @@ pub fn read_obj_mesh(
     let mut reader = BufReader::new(bytes);
     let (models, _) =
         tobj::load_obj_buf(&mut reader, &opts, |_| Err(tobj::LoadError::OpenFileFailed))
-            .map_err(|e| LoadError::Obj(e.to_string()))?;
+            .map_err(|e| LoadError::Obj(with_line(bytes, e.to_string())))?;
     let mut ids: HashMap<[u32; 3], u32> = HashMap::new();
     let mut positions: Vec<Vec3> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
@@ -90,9 +90,9 @@ pub fn read_obj_mesh(
         for c in p.chunks_exact(3) {
             let v = Vec3::new(c[0], c[1], c[2]);
             if !v.is_finite() {
-                return Err(LoadError::Obj(format!(
-                    "model `{}` has a non-finite vertex",
-                    m.name
+                return Err(LoadError::Obj(with_line(
+                    bytes,
+                    format!("model `{}` has a non-finite vertex", m.name),
                 )));
             }
             let next = positions.len() as u32;
@@ -114,10 +114,13 @@ pub fn read_obj_mesh(
             let mut tri = [0u32; 3];
             for k in 0..3 {
                 tri[k] = *local.get(t[k] as usize).ok_or_else(|| {
-                    LoadError::Obj(format!(
-                        "model `{}` face refers to missing vertex {}",
-                        m.name,
-                        t[k] + 1
+                    LoadError::Obj(with_line(
+                        bytes,
+                        format!(
+                            "model `{}` face refers to missing vertex {}",
+                            m.name,
+                            t[k] + 1
+                        ),
                     ))
                 })?;
             }
@@ -128,4 +131,59 @@ pub fn read_obj_mesh(
         return Err(LoadError::Obj("no faces".into()));
     }
     Ok((positions, triangles))
+}
+
+/// `message` prefixed with the line of the first statement in `bytes` that cannot be read
+/// (`tobj` reports what failed, not where), when one is found.
+fn with_line(bytes: &[u8], message: String) -> String {
+    match first_bad_line(bytes) {
+        Some((line, why)) => format!("line {line}: {why} ({message})"),
+        None => message,
+    }
+}
+
+/// The first `v` or `f` statement that is malformed, non-finite or names a vertex that does not
+/// exist yet, with its 1-based line number and the reason.
+fn first_bad_line(bytes: &[u8]) -> Option<(usize, String)> {
+    let text = String::from_utf8_lossy(bytes);
+    let mut vertices = 0i64;
+    for (i, raw) in text.lines().enumerate() {
+        let mut words = raw.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                let coords: Vec<_> = words.take(3).map(str::parse::<f32>).collect();
+                if coords.len() < 3 || coords.iter().any(Result::is_err) {
+                    return Some((i + 1, "a vertex needs three numbers".into()));
+                }
+                if coords.iter().flatten().any(|c| !c.is_finite()) {
+                    return Some((i + 1, "a vertex coordinate is not finite".into()));
+                }
+                vertices += 1;
+            }
+            Some("f") => {
+                let refs: Vec<&str> = words.collect();
+                if refs.len() < 3 {
+                    return Some((i + 1, "a face needs three vertices".into()));
+                }
+                for r in refs {
+                    let first = r.split('/').next().unwrap_or("");
+                    match first.parse::<i64>() {
+                        Ok(k) if k > 0 && k <= vertices => {}
+                        Ok(k) if k < 0 && -k <= vertices => {}
+                        Ok(k) => {
+                            return Some((
+                                i + 1,
+                                format!("face vertex {k} does not exist ({vertices} so far)"),
+                            ));
+                        }
+                        Err(_) => {
+                            return Some((i + 1, format!("face vertex `{r}` is not an index")));
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    None
 }
