@@ -59,6 +59,7 @@ pub mod scene;
 pub mod scenes;
 pub mod technique;
 pub mod topology;
+pub mod triangulate;
 pub mod view_samples;
 pub mod visibility;
 

@@ -89,3 +89,64 @@ fn obj_errors_name_the_line() {
         assert!(e.contains(&format!("line {line}:")), "{text:?}: {e}");
     }
 }
+
+/// Issue 51 item 16: a 100,000-gon face was fan-triangulated into needles, and the BVH build
+/// over them took 73 s. n-gons are now triangulated in their plane (constrained Delaunay):
+/// concave faces are covered exactly once, winding follows the face, and a self-crossing face
+/// is an error naming its line.
+#[test]
+fn ngon_faces_are_triangulated_in_their_plane() {
+    // A concave "U" in the plane y = 1, counter-clockwise seen from +y (normal +y).
+    let u = [
+        (0.0, 0.0),
+        (0.0, 3.0),
+        (1.0, 3.0),
+        (1.0, 1.0),
+        (2.0, 1.0),
+        (2.0, 3.0),
+        (3.0, 3.0),
+        (3.0, 0.0),
+    ];
+    let mut text = String::new();
+    for (x, z) in u {
+        text += &format!("v {x} 1 {z}\n");
+    }
+    text += "f 1 2 3 4 5 6 7 8\n";
+    let s = load(&text).unwrap();
+    assert_eq!(s.scene.triangle_count(), 6);
+    let mut area = 0.0;
+    for t in 0..6 {
+        let [a, b, c] = s.scene.triangle(t);
+        let n = (b - a).cross(c - a);
+        assert!(n.y > 0.0, "triangle {t} winds against the face: {n:?}");
+        area += 0.5 * n.length();
+    }
+    assert!((area - 7.0).abs() < 1e-5, "{area}");
+    // A bow-tie pentagon crosses itself.
+    let e = load("v 0 0 0\nv 2 0 0\nv 0 0 2\nv 2 0 2\nv 1 0 3\nf 1 2 3 4 5\n")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("line 6:"), "{e}");
+    // A large circle: n - 2 triangles, none of them a needle from one vertex.
+    let n = 20_000;
+    let mut text = String::new();
+    for k in 0..n {
+        let a = std::f64::consts::TAU * k as f64 / n as f64;
+        text += &format!("v {} 0 {}\n", a.cos(), -a.sin());
+    }
+    text += "f";
+    for k in 1..=n {
+        text += &format!(" {k}");
+    }
+    text += "\n";
+    let s = load(&text).unwrap();
+    assert_eq!(s.scene.triangle_count(), n - 2);
+    let mut degree = vec![0u32; s.scene.positions().len()];
+    for t in s.scene.triangles() {
+        for v in t {
+            degree[*v as usize] += 1;
+        }
+    }
+    let most = degree.into_iter().max().unwrap();
+    assert!(most < 64, "a vertex in {most} triangles: a fan");
+}

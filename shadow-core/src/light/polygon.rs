@@ -2,7 +2,6 @@
 //! triangulation so that sampling is area-uniform over any simple outline.
 
 use glam::{DVec2, Vec2, Vec3};
-use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
 
 use super::{AreaLight, LightError, LightGeometry, Radiance, check_finite3};
 use crate::geometry::{Aabb, orthonormal_basis, polygon_signed_area};
@@ -80,8 +79,12 @@ impl PolygonLight {
         if !(signed > 0.0) {
             return Err(LightError::InvalidPolygon("outline has no area".into()));
         }
-        check_simple(&local)?;
-        let triangles = triangulate(&local)?;
+        let outline2: Vec<glam::DVec2> = local.iter().map(|p| p.as_dvec2()).collect();
+        let triangles: Vec<[Vec2; 3]> = crate::triangulate::triangulate_simple(&outline2)
+            .map_err(|e| LightError::InvalidPolygon(e.to_string()))?
+            .into_iter()
+            .map(|t| t.map(|i| local[i]))
+            .collect();
         let areas: Vec<f64> = triangles
             .iter()
             .map(|t| 0.5 * (t[1] - t[0]).as_dvec2().perp_dot((t[2] - t[0]).as_dvec2()))
@@ -150,95 +153,6 @@ fn area_centroid(poly: &[Vec2]) -> Vec2 {
     (c / (3.0 * a)).as_vec2()
 }
 
-fn segments_cross(a: Vec2, b: Vec2, c: Vec2, d: Vec2) -> bool {
-    let (a, b, c, d) = (a.as_dvec2(), b.as_dvec2(), c.as_dvec2(), d.as_dvec2());
-    let o = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
-    let (d1, d2, d3, d4) = (o(c, d, a), o(c, d, b), o(a, b, c), o(a, b, d));
-    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
-        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
-    {
-        return true;
-    }
-    let on = |p: DVec2, q: DVec2, r: DVec2| {
-        o(p, q, r) == 0.0 && r.cmpge(p.min(q)).all() && r.cmple(p.max(q)).all()
-    };
-    on(c, d, a) || on(c, d, b) || on(a, b, c) || on(a, b, d)
-}
-
-fn check_simple(poly: &[Vec2]) -> Result<(), LightError> {
-    let n = poly.len();
-    for i in 0..n {
-        for j in i + 1..n {
-            if poly[i] == poly[j] {
-                return Err(LightError::InvalidPolygon(format!(
-                    "vertices {i} and {j} coincide"
-                )));
-            }
-        }
-    }
-    for i in 0..n {
-        for j in i + 1..n {
-            let adjacent = j == i + 1 || (i == 0 && j == n - 1);
-            if !adjacent && segments_cross(poly[i], poly[(i + 1) % n], poly[j], poly[(j + 1) % n]) {
-                return Err(LightError::InvalidPolygon(format!(
-                    "edges {i} and {j} intersect: the outline is not simple"
-                )));
-            }
-        }
-    }
-    Ok(())
-}
-
-fn point_in_polygon(poly: &[Vec2], p: Vec2) -> bool {
-    let mut inside = false;
-    let n = poly.len();
-    for i in 0..n {
-        let (a, b) = (poly[i], poly[(i + 1) % n]);
-        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
-            inside = !inside;
-        }
-    }
-    inside
-}
-
-fn triangulate(poly: &[Vec2]) -> Result<Vec<[Vec2; 3]>, LightError> {
-    let mut cdt: ConstrainedDelaunayTriangulation<Point2<f64>> =
-        ConstrainedDelaunayTriangulation::new();
-    let mut handles = Vec::with_capacity(poly.len());
-    for p in poly {
-        let h = cdt
-            .insert(Point2::new(p.x as f64, p.y as f64))
-            .map_err(|e| LightError::InvalidPolygon(format!("triangulation failed: {e:?}")))?;
-        handles.push(h);
-    }
-    for i in 0..handles.len() {
-        let (a, b) = (handles[i], handles[(i + 1) % handles.len()]);
-        if !cdt.can_add_constraint(a, b) {
-            return Err(LightError::InvalidPolygon(format!(
-                "edge {i} crosses another edge"
-            )));
-        }
-        cdt.add_constraint(a, b);
-    }
-    let tris: Vec<[Vec2; 3]> = cdt
-        .inner_faces()
-        .map(|f| f.positions().map(|p| Vec2::new(p.x as f32, p.y as f32)))
-        .filter(|t| point_in_polygon(poly, (t[0] + t[1] + t[2]) / 3.0))
-        .map(|t| {
-            // Counter-clockwise triangles.
-            if (t[1] - t[0]).perp_dot(t[2] - t[0]) < 0.0 {
-                [t[0], t[2], t[1]]
-            } else {
-                t
-            }
-        })
-        .collect();
-    if tris.is_empty() {
-        return Err(LightError::InvalidPolygon("triangulation is empty".into()));
-    }
-    Ok(tris)
-}
-
 impl AreaLight for PolygonLight {
     fn geometry(&self) -> LightGeometry<'_> {
         LightGeometry::Polygon {
@@ -305,6 +219,22 @@ mod tests {
             .sum();
         assert!((tri_area - 3.0).abs() < 1e-5);
         assert_eq!(l.triangle_count(), 4);
+    }
+
+    /// Issue 51 item 16: the simplicity test was quadratic (43 s for 100,000 vertices).
+    #[test]
+    fn a_star_of_a_hundred_thousand_vertices_is_a_light() {
+        let n = 100_000;
+        let outline: Vec<Vec3> = (0..n)
+            .map(|k| {
+                let a = std::f32::consts::TAU * k as f32 / n as f32;
+                let r = if k % 2 == 0 { 1.0 } else { 0.9 };
+                Vec3::new(r * a.cos(), 2.0, -r * a.sin())
+            })
+            .collect();
+        let l = PolygonLight::new(outline, Radiance::Constant(Vec3::ONE)).unwrap();
+        assert_eq!(l.triangle_count(), n - 2);
+        assert!(l.area() > 0.9 * 0.9 * std::f32::consts::PI && l.area() < std::f32::consts::PI);
     }
 
     #[test]

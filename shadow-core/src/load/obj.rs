@@ -1,4 +1,5 @@
-//! Wavefront OBJ loading through `tobj`: faces triangulated, positions welded (exactly equal
+//! Wavefront OBJ loading through `tobj`: faces triangulated (n-gons by constrained Delaunay
+//! triangulation in their plane), positions welded (exactly equal
 //! positions share one vertex, so meshes split at UV seams become closed), normals dropped (OBJ
 //! normals are per corner and often split; the scene's geometric normals are exact).
 
@@ -59,7 +60,7 @@ pub fn read_obj_mesh(
     limits: &LoadLimits,
 ) -> Result<(Vec<Vec3>, Vec<[u32; 3]>), LoadError> {
     let opts = tobj::LoadOptions {
-        triangulate: true,
+        triangulate: false,
         single_index: false,
         ignore_points: true,
         ignore_lines: true,
@@ -71,6 +72,7 @@ pub fn read_obj_mesh(
     let mut ids: HashMap<[u32; 3], u32> = HashMap::new();
     let mut positions: Vec<Vec3> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
+    let mut faces = 0usize;
     for m in &models {
         let p = &m.mesh.positions;
         if p.len() % 3 != 0 {
@@ -104,27 +106,35 @@ pub fn read_obj_mesh(
                 });
             local.push(id);
         }
-        if m.mesh.indices.len() % 3 != 0 {
-            return Err(LoadError::Obj(format!(
-                "model `{}` was not triangulated",
-                m.name
-            )));
-        }
-        for t in m.mesh.indices.chunks_exact(3) {
-            let mut tri = [0u32; 3];
-            for k in 0..3 {
-                tri[k] = *local.get(t[k] as usize).ok_or_else(|| {
+        let mut corners = Vec::new();
+        let mut at = 0usize;
+        let arities: Vec<usize> = if m.mesh.face_arities.is_empty() {
+            vec![3; m.mesh.indices.len() / 3]
+        } else {
+            m.mesh.face_arities.iter().map(|&a| a as usize).collect()
+        };
+        for arity in arities {
+            let face =
+                m.mesh.indices.get(at..at + arity).ok_or_else(|| {
+                    LoadError::Obj(format!("model `{}` has a partial face", m.name))
+                })?;
+            at += arity;
+            corners.clear();
+            for &k in face {
+                corners.push(*local.get(k as usize).ok_or_else(|| {
                     LoadError::Obj(with_line(
                         bytes,
-                        format!(
-                            "model `{}` face refers to missing vertex {}",
-                            m.name,
-                            t[k] + 1
-                        ),
+                        format!("model `{}` face refers to missing vertex {}", m.name, k + 1),
                     ))
-                })?;
+                })?);
             }
-            triangles.push(tri);
+            faces += 1;
+            triangulate_face(&corners, &positions, &mut triangles).map_err(|why| {
+                LoadError::Obj(match face_line(bytes, faces) {
+                    Some(line) => format!("line {line}: a face of {arity} vertices {why}"),
+                    None => format!("model `{}`: a face of {arity} vertices {why}", m.name),
+                })
+            })?;
         }
     }
     if triangles.is_empty() {
@@ -186,4 +196,71 @@ fn first_bad_line(bytes: &[u8]) -> Option<(usize, String)> {
         }
     }
     None
+}
+
+/// Appends the triangles of one face (vertex ids into `positions`): triangles as they are, a
+/// convex quad as two triangles from its first corner, anything else by the constrained
+/// Delaunay triangulation of the face projected on its plane ([`crate::triangulate`]): a fan
+/// over a large n-gon gives needles that make the BVH build quadratic (issue 51 item 16) and
+/// covers a concave face wrongly.
+fn triangulate_face(
+    corners: &[u32],
+    positions: &[Vec3],
+    out: &mut Vec<[u32; 3]>,
+) -> Result<(), String> {
+    let p = |k: usize| positions[corners[k] as usize].as_dvec3();
+    match corners.len() {
+        0..=2 => return Err("has fewer than three vertices".into()),
+        3 => {
+            out.push([corners[0], corners[1], corners[2]]);
+            return Ok(());
+        }
+        4 => {
+            let (n0, n1) = (
+                (p(1) - p(0)).cross(p(2) - p(0)),
+                (p(2) - p(0)).cross(p(3) - p(0)),
+            );
+            let (m0, m1) = (
+                (p(2) - p(1)).cross(p(3) - p(1)),
+                (p(3) - p(1)).cross(p(0) - p(1)),
+            );
+            if n0.dot(n1) > 0.0 && m0.dot(m1) > 0.0 {
+                out.push([corners[0], corners[1], corners[2]]);
+                out.push([corners[0], corners[2], corners[3]]);
+                return Ok(());
+            }
+        }
+        _ => {}
+    }
+    // Newell's normal, then the face in its plane.
+    let n = corners.len();
+    let mut normal = glam::DVec3::ZERO;
+    for k in 0..n {
+        let (a, b) = (p(k), p((k + 1) % n));
+        normal += glam::DVec3::new(
+            (a.y - b.y) * (a.z + b.z),
+            (a.z - b.z) * (a.x + b.x),
+            (a.x - b.x) * (a.y + b.y),
+        );
+    }
+    let normal = normal.try_normalize().ok_or("has no area")?;
+    let (t, b) = normal.any_orthonormal_pair();
+    let flat: Vec<glam::DVec2> = (0..n)
+        .map(|k| glam::DVec2::new(p(k).dot(t), p(k).dot(b)))
+        .collect();
+    let tris = crate::triangulate::triangulate_simple(&flat).map_err(|e| e.to_string())?;
+    // Triangles wind like the face (counter-clockwise about its Newell normal in the plane
+    // frame `t, b`, whose normal `t x b` is the Newell normal).
+    out.extend(tris.into_iter().map(|t| t.map(|k| corners[k])));
+    Ok(())
+}
+
+/// The 1-based line of the `face`-th (1-based) face statement in `bytes`.
+fn face_line(bytes: &[u8], face: usize) -> Option<usize> {
+    String::from_utf8_lossy(bytes)
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| l.split_whitespace().next() == Some("f"))
+        .nth(face.checked_sub(1)?)
+        .map(|(i, _)| i + 1)
 }
