@@ -409,6 +409,46 @@ pub fn technique_cases(preset: &Preset, width: u32, height: u32) -> Vec<StressRe
             Err(e) => result(label, name, false, e),
         });
     }
+    // Issue 51 item 12: planar lights emit from their front side, so receivers behind the
+    // light (or level with it) get V = 0 from every technique; a light facing up over the
+    // floor gave V of about 0.97 (ref, DCS, AFSM) or 1 (PCF, PCSS, SSM).
+    let away = setup_of(
+        "facing-away",
+        vec![
+            mesh(floor(6.0, 0.0)),
+            mesh(quad(
+                Vec3::new(0.0, 1.0, 0.0),
+                Vec3::new(0.3, 0.0, 0.0),
+                Vec3::new(0.0, 0.0, -0.3),
+            )),
+        ],
+        Arc::new(
+            RectLight::facing(
+                Vec3::new(0.0, 2.0, 0.0),
+                Vec3::Y,
+                1.0,
+                1.0,
+                Radiance::Constant(Vec3::ONE),
+            )
+            .expect("valid"),
+        ),
+        cam,
+    );
+    let view = view_of(&away);
+    out.push(match run_on(preset, &away, &view, 3) {
+        Ok((v, ..)) => {
+            let lit = (0..v.len())
+                .filter(|&i| v.is_valid(i) && v.value(i) > 0.0)
+                .count();
+            result(
+                "light-facing-away",
+                name,
+                lit == 0,
+                format!("{lit} pixels behind the light see some of it"),
+            )
+        }
+        Err(e) => result("light-facing-away", name, false, e),
+    });
     // A tiny light tends to the hard shadow.
     let tiny = setup_of(
         "tiny-light",

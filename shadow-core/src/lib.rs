@@ -22,7 +22,8 @@
 //!
 //! The visibility coefficient is `V(p) = (1/|L|) * integral of v(p, y) dA(y)` over the light
 //! (DCS eq. 1): the unweighted fraction of the light's area visible from `p`, where `y` below
-//! `p`'s tangent plane counts as occluded.
+//! `p`'s tangent plane counts as occluded, and a receiver behind a planar light (which emits
+//! from its front side only) gets none of it.
 //!
 //! ```
 //! use shadow_core::prelude::*;

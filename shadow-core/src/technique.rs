@@ -359,6 +359,31 @@ impl Estimate {
     }
 }
 
+impl Estimate {
+    /// Applies the light-side rule every technique shares: a receiver behind the plane a
+    /// planar light emits from (or in it) gets no light, so its visibility, per-sample
+    /// visibility and direct light are zero ([`crate::light::LightGeometry::behind`]). Counts
+    /// the pixels in `pixels-behind-light`. Techniques call it last in their estimate, after
+    /// skipping those pixels' work where they can.
+    pub fn darken_behind_light(&mut self, view: &ViewSamples, light: &dyn AreaLight) {
+        let geometry = light.geometry();
+        if geometry.emitting_plane().is_none() {
+            return;
+        }
+        let mut count = 0u64;
+        for i in 0..view.len() {
+            if view.get(i).is_some_and(|s| geometry.behind(s.position)) {
+                self.visibility.darken(i);
+                if let Some(d) = &mut self.direct {
+                    d[i] = Vec3::ZERO;
+                }
+                count += 1;
+            }
+        }
+        self.stats.add("pixels-behind-light", count);
+    }
+}
+
 /// A soft-shadow technique: a configuration that prepares a scene and light.
 ///
 /// Object-safe so that suites and tools hold `Vec<Box<dyn ShadowTechnique>>`; construction

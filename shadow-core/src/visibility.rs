@@ -151,6 +151,35 @@ pub struct VisibilityImage {
 }
 
 impl VisibilityImage {
+    /// Sets pixel `i` to "no light at all": `V = 0`, every sample occluded (a depth complexity
+    /// of 1 where the buffer holds counters), class [`PixelClass::Skipped`] where the technique
+    /// classifies. Background pixels are left as they are.
+    pub fn darken(&mut self, i: usize) {
+        if !self.valid.get(i).copied().unwrap_or(false) {
+            return;
+        }
+        match &mut self.coefficients {
+            Coefficients::Scalar(v) => v[i] = 0.0,
+            Coefficients::Rgb(v) => v[i] = Vec3::ZERO,
+        }
+        if let Some(c) = &mut self.classes {
+            c[i] = PixelClass::Skipped;
+        }
+        match &mut self.per_sample {
+            Some(PerSampleVisibility::Bits { samples, words }) => {
+                let wpp = samples.div_ceil(64) as usize;
+                words[i * wpp..(i + 1) * wpp].fill(0);
+            }
+            Some(PerSampleVisibility::Counters { samples, counts }) => {
+                let n = *samples as usize;
+                for c in &mut counts[i * n..(i + 1) * n] {
+                    *c = (*c).max(1);
+                }
+            }
+            None => {}
+        }
+    }
+
     /// A scalar buffer for `view`, all zero.
     pub fn scalar(view: &ViewSamples) -> Self {
         Self {

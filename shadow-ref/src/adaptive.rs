@@ -769,6 +769,7 @@ impl PreparedShadows for PreparedAdaptive {
         vis.validate()?;
         let mut est = Estimate::new(vis, stats);
         est.direct = direct_out;
+        est.darken_behind_light(view, self.inner.p.light.as_ref());
         Ok(est)
     }
 }

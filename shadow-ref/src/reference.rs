@@ -507,6 +507,7 @@ impl PreparedShadows for PreparedReference {
         if outputs.direct {
             est.direct = Some(est.stats.time("direct", || self.direct_illumination(view)));
         }
+        est.darken_behind_light(view, self.p.light.as_ref());
         Ok(est)
     }
 }

@@ -420,7 +420,9 @@ impl PreparedShadows for PreparedFilter {
                 ),
             ));
         }
-        self.config.run(&self.p, view)
+        let mut est = self.config.run(&self.p, view)?;
+        est.darken_behind_light(view, self.p.light.as_ref());
+        Ok(est)
     }
 }
 

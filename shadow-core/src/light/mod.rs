@@ -157,6 +157,30 @@ impl LightGeometry<'_> {
         }
     }
 
+    /// The plane a one-sided (planar) light emits from: a point on it and its unit normal,
+    /// the side light leaves by. `None` for spheres and points, which emit all around.
+    pub fn emitting_plane(&self) -> Option<(Vec3, Vec3)> {
+        match *self {
+            Self::Rectangle { center, normal, .. } | Self::Disk { center, normal, .. } => {
+                Some((center, normal))
+            }
+            Self::Polygon { outline, normal } => outline.first().map(|p| (*p, normal)),
+            Self::Sphere { .. } | Self::Point { .. } => None,
+        }
+    }
+
+    /// True when `p` gets no light at all from this light because it lies behind the plane a
+    /// planar light emits from, or in that plane (up to a grazing angle of `1e-6` radians, so
+    /// that rounding of a receiver level with the light cannot decide it). Planar lights emit
+    /// from their front side only (DESIGN section 3), so every technique gives such a receiver
+    /// `V = 0` ([`crate::technique::Estimate::darken_behind_light`]).
+    pub fn behind(&self, p: Vec3) -> bool {
+        self.emitting_plane().is_some_and(|(o, n)| {
+            let d = p - o;
+            d.dot(n) <= 1e-6 * d.length()
+        })
+    }
+
     /// A bounding rectangle of a planar light in its own plane, corners in order: the
     /// rectangle itself, the square around a disk, the bounding rectangle of a polygon. `None`
     /// for spheres and points.
@@ -323,4 +347,30 @@ pub(crate) fn unit(v: Vec3, what: &'static str) -> Result<Vec3, LightError> {
     check_finite3(v, what)?;
     v.try_normalize()
         .ok_or(LightError::DegenerateFrame("zero-length direction"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 51 item 12: one light-side rule for every technique.
+    #[test]
+    fn planar_lights_light_only_their_front_side() {
+        let r = RectLight::facing(
+            Vec3::new(0.0, 2.0, 0.0),
+            Vec3::NEG_Y,
+            1.0,
+            1.0,
+            Radiance::Constant(Vec3::ONE),
+        )
+        .unwrap();
+        let g = r.geometry();
+        assert!(!g.behind(Vec3::ZERO));
+        assert!(g.behind(Vec3::new(0.0, 3.0, 0.0)));
+        // Level with the light (a ceiling around a recessed panel): no light.
+        assert!(g.behind(Vec3::new(5.0, 2.0, 1.0)));
+        assert!(!g.behind(Vec3::new(5.0, 1.99, 1.0)));
+        let s = SphereLight::new(Vec3::ZERO, 1.0, Radiance::Constant(Vec3::ONE)).unwrap();
+        assert!(!s.geometry().behind(Vec3::new(0.0, -5.0, 0.0)));
+    }
 }

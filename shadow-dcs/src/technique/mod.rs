@@ -510,6 +510,7 @@ impl PreparedShadows for PreparedDcs {
             est.direct = Some(self.direct_illumination(view)?);
             est.stats.add_time("direct", t0.elapsed().as_secs_f64());
         }
+        est.darken_behind_light(view, self.p.light.as_ref());
         Ok(est)
     }
 }
