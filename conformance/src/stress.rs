@@ -295,12 +295,15 @@ pub fn technique_cases(preset: &Preset, width: u32, height: u32) -> Vec<StressRe
     ] {
         let r = match (&small_out, run_on(preset, &setup, &view_of(&setup), 3)) {
             (Ok((a, ..)), Ok((b, ..))) => {
+                // A shadow map's texels follow the receivers it must hold (a floor to the
+                // horizon widens it), so the bound is the preset's own error tolerance.
+                let bound = tol.max(invariance);
                 let e = rmse_common(a, &b);
                 result(
                     label,
                     name,
-                    e <= invariance,
-                    format!("rmse against the 6 m floor alone {e:.5} (tolerance {invariance})"),
+                    e <= bound,
+                    format!("rmse against the 6 m floor alone {e:.5} (tolerance {bound:.3})"),
                 )
             }
             (Err(e), _) => result(label, name, false, e.clone()),
@@ -388,6 +391,10 @@ pub fn technique_cases(preset: &Preset, width: u32, height: u32) -> Vec<StressRe
             ),
         ),
     ];
+    // Issue 51: a Cornell box with its light recessed in a ceiling fixture (receivers level
+    // with the light, a ceiling between receivers and light, walls touching the fixture).
+    let mut cases = cases;
+    cases.push(("cornell-box", builtin("cornell-box").expect("built-in")));
     for (label, setup) in &cases {
         let view = view_of(setup);
         out.push(match run_on(preset, setup, &view, 3) {

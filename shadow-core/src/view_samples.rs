@@ -117,6 +117,21 @@ impl ViewSamples {
                     *tri = NO_TRIANGLE;
                     return;
                 }
+                // The rasterizer's coverage test admits pixel centres within rounding of an
+                // edge, whose ray meets the plane just outside the triangle: a floor point a
+                // ULP beyond the foot of a wall lies behind that wall, and every technique drew
+                // a line of false shadow along room corners. The closest point of the
+                // triangle, moved a hair (2^-20 of the way) toward its centroid, puts it back
+                // on the surface the pixel sees and strictly in front of the neighbour.
+                // A hit on an edge (up to rounding) is moved the same way: a floor point
+                // exactly at the foot of a wall starts its shadow rays in the wall's plane.
+                const HAIR: f64 = 1.0 / 1_048_576.0;
+                let on = closest_on_triangle(a64, b64, c64, hit);
+                let hit = if barycentric(a64, b64, c64, n64, on).min_element() < HAIR {
+                    on + ((a64 + b64 + c64) / 3.0 - on) * HAIR
+                } else {
+                    on
+                };
                 let geo = n64.normalize();
                 let flip = geo.dot(d64) > 0.0;
                 let geo = if flip { -geo } else { geo };
@@ -249,6 +264,40 @@ impl ViewSamples {
 }
 
 /// Barycentric coordinates of `p` (on the plane of `a, b, c` with normal `n`).
+/// The point of triangle `abc` closest to `p` (Ericson, "Real-Time Collision Detection",
+/// section 5.1.5), `p` itself when it lies over the triangle.
+fn closest_on_triangle(a: DVec3, b: DVec3, c: DVec3, p: DVec3) -> DVec3 {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    // Inside: keep the ray's hit (it lies in the plane up to rounding already).
+    p
+}
+
 fn barycentric(a: DVec3, b: DVec3, c: DVec3, n: DVec3, p: DVec3) -> DVec3 {
     let nn = n.length_squared();
     let wa = (c - b).cross(p - b).dot(n) / nn;

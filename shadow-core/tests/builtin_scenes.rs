@@ -3,11 +3,11 @@
 use glam::{DVec3, Vec3};
 use shadow_core::light::LightKind;
 use shadow_core::prelude::*;
-use shadow_core::scenes::{BUILTIN_SCENES, builtin, transformed};
+use shadow_core::scenes::{BUILTIN_SCENES, STRESS_SCENES, builtin, transformed};
 
 #[test]
 fn every_builtin_scene_renders_view_samples() {
-    for name in BUILTIN_SCENES {
+    for name in BUILTIN_SCENES.iter().chain(&STRESS_SCENES) {
         let s = builtin(name).unwrap();
         assert_eq!(s.lights.len(), 1, "{name}");
         let cam = s.camera.unwrap();
@@ -34,6 +34,26 @@ fn every_builtin_scene_renders_view_samples() {
             .to_string()
             .contains("quad-over-plane")
     );
+}
+
+/// Issue 51: the stress suite's Cornell box. A pixel on a room corner (floor meeting wall) is
+/// lit like its neighbours: its view sample lay a float step outside the floor, behind the
+/// wall, and every technique drew a line of false shadow along the corners.
+#[test]
+fn room_corners_are_not_shadowed_by_the_wall_they_meet() {
+    let s = builtin("cornell-box").unwrap();
+    let cam = s.camera.unwrap();
+    let view = ViewSamples::render(s.scene.as_ref(), &cam, 192, 192).unwrap();
+    for i in 0..view.len() {
+        if let Some(v) = view.get(i) {
+            // Every view sample lies inside the room's walls, never beyond them.
+            let p = v.position;
+            assert!(
+                p.x >= -1.0 && p.x <= 1.0 && p.z >= -1.0 && p.y >= 0.0,
+                "pixel {i} at {p:?}"
+            );
+        }
+    }
 }
 
 #[test]
