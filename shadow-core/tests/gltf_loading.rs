@@ -299,7 +299,7 @@ fn glb_and_external_buffers_load() {
     // GLB: JSON chunk + BIN chunk.
     let mut glb_doc = test_document();
     glb_doc["buffers"][0] = json!({"byteLength": bin.len()});
-    let glb = make_glb(&glb_doc.to_string(), &bin);
+    let glb = shadow_core::load::glb_bytes(&glb_doc.to_string(), &bin);
     std::fs::write(dir.join("scene.glb"), &glb).unwrap();
     let from_glb = load_gltf(&dir.join("scene.glb"), &LoadLimits::default()).unwrap();
     assert_eq!(from_glb.lights.len(), 3);
@@ -314,29 +314,6 @@ fn glb_and_external_buffers_load() {
         Err(LoadError::Io { .. })
     ));
     std::fs::remove_dir_all(&dir).ok();
-}
-
-fn make_glb(json_text: &str, bin: &[u8]) -> Vec<u8> {
-    let mut j = json_text.as_bytes().to_vec();
-    while !j.len().is_multiple_of(4) {
-        j.push(b' ');
-    }
-    let mut b = bin.to_vec();
-    while !b.len().is_multiple_of(4) {
-        b.push(0);
-    }
-    let total = 12 + 8 + j.len() + 8 + b.len();
-    let mut out = Vec::new();
-    out.extend(b"glTF");
-    out.extend(2u32.to_le_bytes());
-    out.extend((total as u32).to_le_bytes());
-    out.extend((j.len() as u32).to_le_bytes());
-    out.extend(b"JSON");
-    out.extend(j);
-    out.extend((b.len() as u32).to_le_bytes());
-    out.extend(b"BIN\0");
-    out.extend(b);
-    out
 }
 
 #[test]
@@ -691,7 +668,7 @@ fn truncated_files_say_they_are_truncated() {
     let limits = LoadLimits::default();
     let doc = test_document();
     let text = doc.to_string();
-    let glb = make_glb(&text, b"");
+    let glb = shadow_core::load::glb_bytes(&text, b"");
     for cut in [13, 40, glb.len() / 2, glb.len() - 1] {
         let e = load_gltf_slice(&glb[..cut], None, "cut", &limits).unwrap_err();
         assert!(e.to_string().contains("truncated"), "GLB cut at {cut}: {e}");
@@ -739,4 +716,43 @@ fn deep_hierarchies_load_and_cycles_are_named() {
     cyclic["nodes"][base + chain - 1]["children"] = json!([base]);
     let e = load(&cyclic).unwrap_err();
     assert!(e.to_string().contains("reached twice"), "{e}");
+}
+
+/// Issue 51 item 17: a double-sided or zero-area emissive mesh was called "neither planar nor a
+/// closed sphere"; each now says what it is.
+#[test]
+fn double_sided_and_zero_area_emitters_say_so() {
+    let cases: [(&str, Vec<Vec3>, Vec<u32>, &str); 2] = [
+        (
+            "double-sided",
+            square(0.5).0,
+            vec![0, 1, 2, 0, 2, 3, 0, 2, 1, 0, 3, 2],
+            "both ways",
+        ),
+        (
+            "flat-line",
+            vec![Vec3::ZERO, Vec3::X, 2.0 * Vec3::X],
+            vec![0, 1, 2],
+            "no area",
+        ),
+    ];
+    for (name, positions, indices, expected) in cases {
+        let mut w = Writer::default();
+        let grey = w.material(json!({}));
+        let lamp = w.material(json!({"emissiveFactor": [1.0, 1.0, 1.0]}));
+        let (fp, fi) = square(3.0);
+        w.mesh("floor", &fp, &fi, None, grey);
+        w.mesh(name, &positions, &indices, None, lamp);
+        let doc = w.document(
+            json!([{"mesh": 0}, {"mesh": 1, "translation": [0.0, 2.0, 0.0]}]),
+            json!([]),
+        );
+        match load(&doc) {
+            Err(LoadError::Unsupported { mesh, reason }) => {
+                assert_eq!(mesh, name);
+                assert!(reason.contains(expected), "{name}: {reason}");
+            }
+            other => panic!("{name}: expected Unsupported, got {other:?}"),
+        }
+    }
 }

@@ -150,3 +150,28 @@ fn ngon_faces_are_triangulated_in_their_plane() {
     let most = degree.into_iter().max().unwrap();
     assert!(most < 64, "a vertex in {most} triangles: a fan");
 }
+
+/// Found by the loaders' fuzz test: a texture-coordinate index of `-11` after one `vt` made
+/// `tobj` overflow (a panic in debug builds, a wrapped index in release). References are
+/// checked before `tobj` sees them.
+#[test]
+fn out_of_range_texture_and_normal_indices_are_errors_not_overflows() {
+    for (text, what) in [
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/-11 3/1\n",
+            "texture coordinate -11",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//2 3//1\n",
+            "normal 2",
+        ),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 18446744073709551615\n",
+            "is not an index",
+        ),
+    ] {
+        let e = load(text).unwrap_err().to_string();
+        assert!(e.contains("line 5:") || e.contains("line 4:"), "{e}");
+        assert!(e.contains(what), "{e}");
+    }
+}

@@ -120,7 +120,44 @@ pub fn light_from_emissive_mesh(
             .map(|p| (p.as_dvec3() - centroid).length())
             .collect();
         let r = dists.iter().sum::<f64>() / dists.len() as f64;
-        if closed && welded.len() >= 6 && dists.iter().all(|d| (d - r).abs() <= 2e-3 * r) {
+        // A plane through the largest triangle, to tell a flat mesh whose faces cancel
+        // (double-sided, or wound both ways) from one that is not flat at all.
+        let largest = tris.iter().max_by(|a, b| {
+            let area = |t: &&[u32; 3]| {
+                triangle_cross_f64(
+                    welded[t[0] as usize],
+                    welded[t[1] as usize],
+                    welded[t[2] as usize],
+                )
+                .length()
+            };
+            area(a).total_cmp(&area(b))
+        });
+        let flat_both_ways = largest.is_some_and(|t| {
+            let c = triangle_cross_f64(
+                welded[t[0] as usize],
+                welded[t[1] as usize],
+                welded[t[2] as usize],
+            );
+            c.length() > 0.0 && {
+                let nn = c.normalize();
+                let o = welded[t[0] as usize].as_dvec3();
+                welded
+                    .iter()
+                    .all(|p| (p.as_dvec3() - o).dot(nn).abs() <= 1e-4 * diag)
+            }
+        });
+        if !(abs_area > 0.0) {
+            return Err(unsupported(
+                "emissive mesh has no area: every triangle is degenerate",
+            ));
+        } else if flat_both_ways {
+            return Err(unsupported(
+                "emissive mesh is flat but its triangles face both ways (double-sided, or wound \
+                 inconsistently): a planar light emits from one side, so keep one side with \
+                 one winding",
+            ));
+        } else if closed && welded.len() >= 6 && dists.iter().all(|d| (d - r).abs() <= 2e-3 * r) {
             Shape::Sphere(
                 SphereLight::new(centroid.as_vec3(), r as f32, constant.clone())
                     .map_err(light_err)?,

@@ -33,6 +33,30 @@ pub fn load_gltf(path: &Path, limits: &LoadLimits) -> Result<SceneSetup, LoadErr
     load_gltf_slice(&bytes, base.as_deref(), &name, limits)
 }
 
+/// A GLB container (glTF 2.0 section 4.4) holding `json` and one binary chunk `bin`, each
+/// padded to four bytes, for tools and tests that write scenes.
+pub fn glb_bytes(json: &str, bin: &[u8]) -> Vec<u8> {
+    let mut j = json.as_bytes().to_vec();
+    while !j.len().is_multiple_of(4) {
+        j.push(b' ');
+    }
+    let mut b = bin.to_vec();
+    while !b.len().is_multiple_of(4) {
+        b.push(0);
+    }
+    let total = 12 + 8 + j.len() + 8 + b.len();
+    let mut out = b"glTF".to_vec();
+    out.extend(2u32.to_le_bytes());
+    out.extend((total as u32).to_le_bytes());
+    out.extend((j.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(j);
+    out.extend((b.len() as u32).to_le_bytes());
+    out.extend(b"BIN\0");
+    out.extend(b);
+    out
+}
+
 /// Loads glTF from memory; `base` resolves relative URIs (none allowed when `None`).
 ///
 /// # Errors

@@ -65,6 +65,10 @@ pub fn read_obj_mesh(
         ignore_points: true,
         ignore_lines: true,
     };
+    // Every statement `tobj` will index by is checked first (see `first_bad_line`).
+    if let Some((line, why)) = first_bad_line(bytes) {
+        return Err(LoadError::Obj(format!("line {line}: {why}")));
+    }
     let mut reader = BufReader::new(bytes);
     let (models, _) =
         tobj::load_obj_buf(&mut reader, &opts, |_| Err(tobj::LoadError::OpenFileFailed))
@@ -152,23 +156,46 @@ fn with_line(bytes: &[u8], message: String) -> String {
     }
 }
 
-/// The first `v` or `f` statement that is malformed, non-finite or names a vertex that does not
-/// exist yet, with its 1-based line number and the reason.
+/// The first `v`, `vt`, `vn` or `f` statement that is malformed, non-finite or names a vertex,
+/// texture coordinate or normal that does not exist yet, with its 1-based line number and the
+/// reason. Run before `tobj` as well as after its errors: `tobj` does index arithmetic on
+/// references it has not checked (a texture index of `-11` after one `vt` overflowed inside it,
+/// found by the loaders' fuzz test).
 fn first_bad_line(bytes: &[u8]) -> Option<(usize, String)> {
     let text = String::from_utf8_lossy(bytes);
-    let mut vertices = 0i64;
+    let (mut v, mut vt, mut vn) = (0i64, 0i64, 0i64);
+    let in_range = |k: i64, count: i64| (k > 0 && k <= count) || (k < 0 && k >= -count);
     for (i, raw) in text.lines().enumerate() {
         let mut words = raw.split_whitespace();
-        match words.next() {
+        let keyword = words.next();
+        let numbers = |need: usize, words: std::str::SplitWhitespace<'_>| {
+            let c: Vec<_> = words.take(need).map(str::parse::<f32>).collect();
+            if c.len() < need || c.iter().any(Result::is_err) {
+                Some(format!("needs {need} numbers"))
+            } else if c.iter().flatten().any(|x| !x.is_finite()) {
+                Some("a number is not finite".to_string())
+            } else {
+                None
+            }
+        };
+        match keyword {
             Some("v") => {
-                let coords: Vec<_> = words.take(3).map(str::parse::<f32>).collect();
-                if coords.len() < 3 || coords.iter().any(Result::is_err) {
-                    return Some((i + 1, "a vertex needs three numbers".into()));
+                if let Some(why) = numbers(3, words) {
+                    return Some((i + 1, format!("a vertex {why}")));
                 }
-                if coords.iter().flatten().any(|c| !c.is_finite()) {
-                    return Some((i + 1, "a vertex coordinate is not finite".into()));
+                v += 1;
+            }
+            Some("vt") => {
+                if let Some(why) = numbers(1, words) {
+                    return Some((i + 1, format!("a texture coordinate {why}")));
                 }
-                vertices += 1;
+                vt += 1;
+            }
+            Some("vn") => {
+                if let Some(why) = numbers(3, words) {
+                    return Some((i + 1, format!("a normal {why}")));
+                }
+                vn += 1;
             }
             Some("f") => {
                 let refs: Vec<&str> = words.collect();
@@ -176,19 +203,32 @@ fn first_bad_line(bytes: &[u8]) -> Option<(usize, String)> {
                     return Some((i + 1, "a face needs three vertices".into()));
                 }
                 for r in refs {
-                    let first = r.split('/').next().unwrap_or("");
-                    match first.parse::<i64>() {
-                        Ok(k) if k > 0 && k <= vertices => {}
-                        Ok(k) if k < 0 && -k <= vertices => {}
-                        Ok(k) => {
-                            return Some((
-                                i + 1,
-                                format!("face vertex {k} does not exist ({vertices} so far)"),
-                            ));
+                    for (slot, (what, count)) in r.split('/').zip([
+                        ("vertex", v),
+                        ("texture coordinate", vt),
+                        ("normal", vn),
+                    ]) {
+                        if slot.is_empty() && what != "vertex" {
+                            continue;
                         }
-                        Err(_) => {
-                            return Some((i + 1, format!("face vertex `{r}` is not an index")));
+                        match slot.parse::<i64>() {
+                            Ok(k) if in_range(k, count) => {}
+                            Ok(k) => {
+                                return Some((
+                                    i + 1,
+                                    format!("face {what} {k} does not exist ({count} so far)"),
+                                ));
+                            }
+                            Err(_) => {
+                                return Some((
+                                    i + 1,
+                                    format!("face {what} `{slot}` is not an index"),
+                                ));
+                            }
                         }
+                    }
+                    if r.split('/').count() > 3 {
+                        return Some((i + 1, format!("face vertex `{r}` has more than 3 parts")));
                     }
                 }
             }
