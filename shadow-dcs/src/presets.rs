@@ -44,18 +44,6 @@ fn exact_budget(samples: u32, semi: &[(&str, [f64; 5])], scene: &str) -> Option<
     Some(b)
 }
 
-/// Why every exact DCS preset fails the stress suite's `cornell-box` (issue 51), measured at
-/// 48x36 against the same-samples reference: RMSE 0.126 to 0.128, max error 1.0; at 128x96
-/// 931 of 12,288 pixels are off by more than 0.5 and 538 pixels report negative depth
-/// complexities. The receivers at the top of the back wall, under a ceiling that lies 9 cm
-/// in front of the recessed light, get an integration constant of 0 where the ceiling
-/// occludes the whole light: the shadow-volume count from the eye misses the ceiling there.
-/// Removing the fixture's walls and top leaves the error (0.142), so it is the ceiling close
-/// to the light's plane, not geometry crossing it.
-const CORNELL_BOX: &str = "a ceiling 9 cm in front of a recessed light: receivers under it get \
-     an integration constant of 0 (the eye's shadow-volume count misses the ceiling), RMSE \
-     0.13, max error 1";
-
 /// Every DCS preset.
 pub fn presets() -> Vec<Preset> {
     vec![
@@ -67,7 +55,7 @@ pub fn presets() -> Vec<Preset> {
             with_samples: Some(|n, seed| {
                 Ok(Box::new(Dcs::new(n, SamplingStrategy::Stratified, seed)?))
             }),
-            known_limitations: &[("cornell-box", CORNELL_BOX)],
+            known_limitations: &[],
         },
         Preset {
             name: "dcs-64",
@@ -75,7 +63,7 @@ pub fn presets() -> Vec<Preset> {
             make: |seed| Box::new(make(64, SamplingStrategy::Stratified, seed).named("dcs-64")),
             budget: |s| exact_budget(64, budgets::DCS_64_SEMI, s),
             with_samples: None,
-            known_limitations: &[("cornell-box", CORNELL_BOX)],
+            known_limitations: &[],
         },
         Preset {
             name: "dcs-64-interleaved",
@@ -90,7 +78,7 @@ pub fn presets() -> Vec<Preset> {
             },
             budget: |s| exact_budget(64, budgets::DCS_64_INTERLEAVED_SEMI, s),
             with_samples: None,
-            known_limitations: &[("cornell-box", CORNELL_BOX)],
+            known_limitations: &[],
         },
         Preset {
             name: "dcs-64-discrete",
@@ -110,15 +98,12 @@ pub fn presets() -> Vec<Preset> {
                 })
             },
             with_samples: None,
-            known_limitations: &[
-                ("cornell-box", CORNELL_BOX),
-                (
-                    "light-larger-than-scene",
-                    "the line table of DCS section 7.3 spans the light's square, so on a light 300 \
+            known_limitations: &[(
+                "light-larger-than-scene",
+                "the line table of DCS section 7.3 spans the light's square, so on a light 300 \
                  times the occluder one cell is wider than the projected occluder; the exact and \
                  refined modes hold",
-                ),
-            ],
+            )],
         },
         Preset {
             name: "dcs-256",
@@ -126,7 +111,7 @@ pub fn presets() -> Vec<Preset> {
             make: |seed| Box::new(make(256, SamplingStrategy::Stratified, seed).named("dcs-256")),
             budget: |s| exact_budget(256, budgets::DCS_256_SEMI, s),
             with_samples: None,
-            known_limitations: &[("cornell-box", CORNELL_BOX)],
+            known_limitations: &[],
         },
         Preset {
             name: "dcs-standard-silhouettes",

@@ -65,11 +65,7 @@ pub fn presets() -> Vec<Preset> {
             make: |seed| auto("auto-0.01", 0.01, seed),
             budget: |scene| Budget::lookup(AUTO_01, scene),
             with_samples: None,
-            known_limitations: &[(
-                "cornell-box",
-                "picks dcs-256, which fails this scene (its own known limitation): RMSE 0.128; \
-                 the chooser's models do not yet see a ceiling close to the light's plane",
-            )],
+            known_limitations: &[],
         },
         Preset {
             name: "auto-0.003",

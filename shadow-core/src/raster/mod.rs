@@ -634,6 +634,37 @@ mod tests {
     /// top-left rule settles them as for the triangles). Such a quad and a triangle sharing one of
     /// its edges cover each pixel of their union once.
     #[test]
+    fn repeated_vertices_do_not_empty_a_covered_polygon() {
+        // Clipping at a box corner repeats a vertex, exactly or to the last bits; the repeat
+        // made every pixel fail the edge test of the zero-length edge (DCS's shadow-volume
+        // quads on the Cornell box counted nowhere).
+        let persp = persp_view();
+        let quad = vec![
+            Vec3::new(-0.5, -0.4, -2.0),
+            Vec3::new(0.6, -0.3, -2.0),
+            Vec3::new(0.5, 0.5, -2.2),
+            Vec3::new(-0.4, 0.4, -2.2),
+        ];
+        let clean = polygon_pixels(&persp, &quad);
+        assert!(!clean.is_empty());
+        let near = |v: Vec3| Vec3::new(v.x, f32::from_bits(v.y.to_bits() + 1), v.z);
+        for repeated in [
+            vec![quad[0], quad[1], quad[1], quad[2], quad[3]],
+            vec![quad[0], quad[1], quad[2], quad[3], quad[3], quad[0]],
+            vec![
+                quad[0],
+                quad[1],
+                near(quad[1]),
+                quad[2],
+                quad[3],
+                near(quad[3]),
+            ],
+        ] {
+            assert_eq!(polygon_pixels(&persp, &repeated), clean, "{repeated:?}");
+        }
+    }
+
+    #[test]
     fn covered_polygons_equal_their_fan_triangles() {
         let persp = persp_view();
         let r = |k: u64, i: u64| {

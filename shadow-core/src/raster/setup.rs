@@ -364,7 +364,22 @@ pub(super) fn setup_triangle(v: [Vec3; 3], view: &RasterView) -> Vec<ScreenTrian
 /// same outline). `None` when nothing of it is left or its screen area is zero.
 pub(super) fn setup_polygon(v: &[Vec3], view: &RasterView) -> Option<ScreenPolygon> {
     let projected = clip_and_project(v, view);
-    let mut p: Vec<DVec2> = projected.iter().map(|q| q.0).collect();
+    // Vertices within a millionth of a pixel of the previous one are dropped: clipping a
+    // polygon at a box corner repeats a vertex (exactly, or to the last bits), and the edge
+    // between the two copies has no direction, so its edge function excluded every pixel: a
+    // DCS shadow-volume quad clipped at the corner of the box around the view counted nowhere
+    // (the Cornell box's back-wall umbra came out lit).
+    let mut p: Vec<DVec2> = Vec::with_capacity(projected.len());
+    for q in &projected {
+        if p.last()
+            .is_none_or(|l: &DVec2| l.distance_squared(q.0) > 1e-12)
+        {
+            p.push(q.0);
+        }
+    }
+    while p.len() > 1 && p[0].distance_squared(p[p.len() - 1]) <= 1e-12 {
+        p.pop();
+    }
     if p.len() < 3 {
         return None;
     }
