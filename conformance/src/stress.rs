@@ -130,6 +130,18 @@ fn mesh(m: (Vec<Vec3>, Vec<[u32; 3]>)) -> MeshDesc {
     MeshDesc::new(m.0, m.1)
 }
 
+/// The 6 m floor under a 0.6 m occluder square at height 1.
+fn floor_and_square() -> Vec<MeshDesc> {
+    vec![
+        mesh(floor(6.0, 0.0)),
+        mesh(quad(
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(0.3, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, -0.3),
+        )),
+    ]
+}
+
 /// An occluder square made of needle triangles (a fan from one corner with 200 slivers).
 fn sliver_square() -> MeshDesc {
     let mut p = vec![Vec3::new(-0.3, 1.0, -0.3)];
@@ -421,14 +433,7 @@ pub fn technique_cases(preset: &Preset, width: u32, height: u32) -> Vec<StressRe
     // floor gave V of about 0.97 (ref, DCS, AFSM) or 1 (PCF, PCSS, SSM).
     let away = setup_of(
         "facing-away",
-        vec![
-            mesh(floor(6.0, 0.0)),
-            mesh(quad(
-                Vec3::new(0.0, 1.0, 0.0),
-                Vec3::new(0.3, 0.0, 0.0),
-                Vec3::new(0.0, 0.0, -0.3),
-            )),
-        ],
+        floor_and_square(),
         Arc::new(
             RectLight::facing(
                 Vec3::new(0.0, 2.0, 0.0),
@@ -459,14 +464,7 @@ pub fn technique_cases(preset: &Preset, width: u32, height: u32) -> Vec<StressRe
     // A tiny light tends to the hard shadow.
     let tiny = setup_of(
         "tiny-light",
-        vec![
-            mesh(floor(6.0, 0.0)),
-            mesh(quad(
-                Vec3::new(0.0, 1.0, 0.0),
-                Vec3::new(0.3, 0.0, 0.0),
-                Vec3::new(0.0, 0.0, -0.3),
-            )),
-        ],
+        floor_and_square(),
         Arc::new(
             DiskLight::new(
                 Vec3::new(0.1, 2.0, 0.05),
