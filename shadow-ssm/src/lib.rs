@@ -1,7 +1,8 @@
 //! # shadow-ssm
 //!
 //! Soft shadow mapping: every filter reads one light-centre shadow map (GBP07 section 3,
-//! [`shadow_map`]) and its min/max pyramid with GBP07's converging kernel ([`hierarchy`]).
+//! [`shadow_map`], its frustum from [`light_view`]) and its min/max pyramid with GBP07's
+//! converging kernel ([`hierarchy`]).
 //!
 //! * Baselines a renderer would otherwise pick: PCF and PCSS ([`technique`]).
 //! * Back-projection with gap filling (GBP06 as BCS06 section 2 summarises it) and depth peeling
@@ -36,6 +37,7 @@ pub mod hierarchy;
 pub mod light_domain;
 pub mod light_frame;
 pub mod light_space;
+pub mod light_view;
 mod presets;
 pub mod screen_space;
 pub mod shadow_map;

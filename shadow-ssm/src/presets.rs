@@ -18,17 +18,6 @@ fn budget(table: &[(&str, [f64; 5])], false_shadow: &[(&str, f64)], scene: &str)
     Some(b)
 }
 
-/// Why the shadow-map presets fail the stress suite's `cornell-box` (issue 51), measured at
-/// 48x36 against the reference: pcss RMSE 0.245, ssm-backprojection 0.371, ssm-peeling
-/// 0.363, ssm-adaptive 0.199 (pcf 0.163 and ssm-contours 0.072 pass only within their
-/// approximations' wider budgets). Receivers at the top of the walls lie 9 to 11 cm below the
-/// recessed light and a metre beside it, about 84 degrees off its axis: the one perspective map
-/// from the light's centre that holds them spends its 1024 texels on a field of view over 20
-/// times wider than the floor's, so the spheres' shadows on the floor fall within a few texels.
-/// A cube map or several frusta would hold them (AFSM's omni-directional path does).
-const CORNELL_BOX: &str = "receivers 84 degrees off the recessed light's axis widen the single \
-     light-centre map until the floor's shadows span a few texels: RMSE 0.2 to 0.37";
-
 /// Shadow-map resolution of the presets.
 pub const RESOLUTION: u32 = 1024;
 
@@ -55,7 +44,7 @@ pub fn presets() -> Vec<Preset> {
             make: |_| Box::new(ShadowMapFilter::new("pcss", Filter::Pcss, RESOLUTION)),
             budget: |s| budget(budgets::PCSS, budgets::PCSS_FALSE_SHADOW, s),
             with_samples: None,
-            known_limitations: &[("cornell-box", CORNELL_BOX)],
+            known_limitations: &[],
         },
         Preset {
             name: "ssm-backprojection",
@@ -79,7 +68,7 @@ pub fn presets() -> Vec<Preset> {
                 )
             },
             with_samples: None,
-            known_limitations: &[("cornell-box", CORNELL_BOX)],
+            known_limitations: &[],
         },
         Preset {
             name: "ssm-peeling",
@@ -97,7 +86,7 @@ pub fn presets() -> Vec<Preset> {
             },
             budget: |s| budget(budgets::PEELING, budgets::PEELING_FALSE_SHADOW, s),
             with_samples: None,
-            known_limitations: &[("cornell-box", CORNELL_BOX)],
+            known_limitations: &[],
         },
         Preset {
             name: "ssm-contours",
@@ -127,7 +116,7 @@ pub fn presets() -> Vec<Preset> {
             },
             budget: |s| budget(budgets::ADAPTIVE, budgets::ADAPTIVE_FALSE_SHADOW, s),
             with_samples: None,
-            known_limitations: &[("cornell-box", CORNELL_BOX)],
+            known_limitations: &[],
         },
     ]
 }

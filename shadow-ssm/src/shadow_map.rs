@@ -3,16 +3,14 @@
 //! the light, storing linear depth (distance from the light's plane along its axis).
 //!
 //! The frustum is fitted to the view samples that can see the light, widened so that every
-//! occluder able to shadow them is inside: an occluder at depth `d` shadows a receiver at depth
-//! `z_p` only within `w_l / 2 (1/d - 1/z_p)` of it at unit depth (the pyramid of GBP07 eq. 1),
-//! so the receivers' bounds grow by `w_l / (2 z_min)` (at most doubling them), `z_min` being the
-//! nearest scene depth in front of the light.
+//! occluder able to shadow them is inside ([`crate::light_view`]).
 
-use glam::{Affine3A, Vec3};
-use shadow_core::raster::{Projection, RasterError, RasterView, rasterize};
+use glam::{Vec2, Vec3};
+use shadow_core::raster::{RasterError, RasterView, rasterize};
 use shadow_core::scene::Scene;
 
 use crate::light_frame::LightFrame;
+use crate::light_view::{LightView, Window};
 
 /// A light-centre shadow map.
 #[derive(Debug, Clone)]
@@ -30,11 +28,14 @@ pub struct ShadowMap {
     pub layers: u32,
     /// The layered depths, `layers` per texel.
     pub layered: Vec<f32>,
+    /// The frustum's window at unit depth.
+    pub window: Window,
 }
 
 impl ShadowMap {
     /// Renders the shadow map of `scene` for `frame` at `resolution` texels a side, fitted to
-    /// `receivers` (world positions). `None` when no receiver lies in front of the light.
+    /// `receivers` (world positions) and the surfaces that can shadow them
+    /// ([`LightView::window`]). `None` when no receiver lies in front of the light.
     ///
     /// # Errors
     /// [`RasterError`] for an invalid resolution.
@@ -45,108 +46,57 @@ impl ShadowMap {
         resolution: u32,
         layers: u32,
     ) -> Result<Option<Self>, RasterError> {
-        // View space looks down -Z along the light's axis; x, y span the light's plane.
-        let (mut x, mut y) = frame.basis;
-        if x.cross(y).dot(frame.axis) > 0.0 {
-            std::mem::swap(&mut x, &mut y);
-        }
-        let world_from_view = Affine3A::from_cols(
-            x.into(),
-            y.into(),
-            (-frame.axis).into(),
-            frame.center.into(),
-        );
-        let view_from_world = world_from_view.inverse();
-        let extent = scene.bounds().diagonal().max(f32::MIN_POSITIVE);
-        // The nearest geometry in front of the light plane sets the near plane and the margin.
-        let z_min_scene = scene
-            .positions()
-            .iter()
-            .map(|p| -view_from_world.transform_point3(*p).z)
-            .filter(|d| *d > 0.0)
-            .fold(f32::INFINITY, f32::min);
-        let near = (1e-3 * extent).min(0.5 * z_min_scene).max(1e-7 * extent);
-        let (mut lo, mut hi) = (
-            glam::Vec2::splat(f32::INFINITY),
-            glam::Vec2::splat(f32::NEG_INFINITY),
-        );
+        let light = LightView::new(scene, frame);
+        let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+        let mut deepest = 0.0f32;
         for p in receivers {
-            let v = view_from_world.transform_point3(*p);
+            let v = light.view_from_world.transform_point3(*p);
             let d = -v.z;
-            if d > near {
-                let q = glam::Vec2::new(v.x / d, v.y / d);
+            if d > light.near {
+                let q = Vec2::new(v.x / d, v.y / d);
                 lo = lo.min(q);
                 hi = hi.max(q);
+                deepest = deepest.max(d);
             }
         }
         if !(lo.x <= hi.x) {
             return Ok(None);
         }
-        // Every point that can stand between a receiver and the light projects within
-        // `width / (2 z)` of the receiver's projection (z its depth below the light plane). When
-        // that margin is at most the receivers' own extent the map is their square widened by
-        // it (the setting every budget was measured at). When it is wider, as under a wide
-        // light with a small view, the map reaches as far as the margin, never less (a cap
-        // here lost occluders beside the view), and no farther than the geometry projects. Its
-        // texels grow with it: a finer map would need kernels beyond the filters' caps
-        // (`MAX_KERNEL`) to reach the occluders it now holds.
-        let size = (hi - lo).max_element().max(1e-6);
-        let margin = frame.width / (2.0 * z_min_scene.max(near));
-        let (mid, half, resolution) = if margin <= size {
-            ((lo + hi) * 0.5, size * 0.5 + margin, resolution)
-        } else {
-            let (mut glo, mut ghi) = (lo - margin, hi + margin);
-            let mut all_in_front = true;
-            let (mut plo, mut phi) = (
-                glam::Vec2::splat(f32::INFINITY),
-                glam::Vec2::splat(f32::NEG_INFINITY),
-            );
-            for p in scene.positions() {
-                let v = view_from_world.transform_point3(*p);
-                let d = -v.z;
-                if d > near {
-                    let q = glam::Vec2::new(v.x / d, v.y / d);
-                    plo = plo.min(q);
-                    phi = phi.max(q);
-                } else {
-                    all_in_front = false;
-                }
-            }
-            // With a vertex behind the near plane a triangle's projection is not bounded by
-            // its vertices' projections in front: the margin alone bounds the map then.
-            if all_in_front && plo.x <= phi.x {
-                glo = glo.max(plo.min(lo));
-                ghi = ghi.min(phi.max(hi));
-            }
-            let half = (ghi - glo).max_element().max(1e-6) * 0.5;
-            ((glo + ghi) * 0.5, half, resolution)
-        };
-        let view = RasterView {
-            width: resolution,
-            height: resolution,
-            view_from_world,
-            projection: Projection::Perspective {
-                left: mid.x - half,
-                right: mid.x + half,
-                bottom: mid.y - half,
-                top: mid.y + half,
-                near,
-            },
-        };
+        let window = light.window(scene.triangles(), lo, hi, deepest);
+        let mut map = Self::render_view(scene, light.raster_view(window, resolution), layers)?;
+        map.window = window;
+        Ok(Some(map))
+    }
+
+    /// Renders the map of `scene` through the square light-centre frustum `view`.
+    ///
+    /// # Errors
+    /// [`RasterError`] for an invalid resolution.
+    pub fn render_view(
+        scene: &dyn Scene,
+        view: RasterView,
+        layers: u32,
+    ) -> Result<Self, RasterError> {
+        let resolution = view.width;
+        let (left, right, bottom, top, _, _) = view.extents();
         let layers = layers.max(1);
         let frags = rasterize(scene.positions(), scene.triangles(), &view, layers)?;
-        let first: Vec<f32> = (0..(resolution * resolution) as usize)
+        let first: Vec<f32> = (0..(resolution as usize * view.height as usize))
             .map(|i| frags.depth[i * layers as usize])
             .collect();
         let min_depth = first.iter().copied().fold(f32::INFINITY, f32::min);
-        Ok(Some(Self {
-            view,
+        Ok(Self {
             depth: first,
             layers,
             layered: frags.depth,
-            texels_per_unit: resolution as f64 / (2.0 * half as f64),
+            texels_per_unit: resolution as f64 / (right as f64 - left as f64),
             min_depth,
-        }))
+            window: Window {
+                mid: Vec2::new(0.5 * (left + right), 0.5 * (bottom + top)),
+                half: 0.5 * (right - left),
+            },
+            view,
+        })
     }
 
     /// Texel coordinates (continuous, texel centres at `i + 0.5`) and linear depth of `p`, or
@@ -225,6 +175,7 @@ impl ShadowMap {
 impl ShadowMap {
     /// A one-layer `r x r` map over unit-depth `[-1, 1]^2` at the identity view (tests).
     pub(crate) fn unit_square(r: u32, depth: Vec<f32>) -> Self {
+        use glam::Affine3A;
         use shadow_core::raster::Projection;
         let min_depth = depth.iter().copied().fold(f32::INFINITY, f32::min);
         Self {
@@ -245,6 +196,10 @@ impl ShadowMap {
             min_depth,
             layers: 1,
             layered: depth,
+            window: Window {
+                mid: Vec2::ZERO,
+                half: 1.0,
+            },
         }
     }
 }

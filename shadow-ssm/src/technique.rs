@@ -39,6 +39,7 @@ use crate::hierarchy::MinMaxPyramid;
 use crate::light_domain::{Covered, LightDomain, RadianceTable};
 use crate::light_frame::LightFrame;
 use crate::light_space::{self, Contours};
+use crate::light_view::MAX_OFF_AXIS_DEGREES;
 use crate::screen_space::{self, ScreenSpace};
 use crate::shadow_map::ShadowMap;
 
@@ -459,6 +460,20 @@ impl ShadowMapFilter {
                 self.layers(),
             )
         })?;
+        if let Some(m) = &sm {
+            let reach = m.window.off_axis_degrees();
+            if !(reach <= MAX_OFF_AXIS_DEGREES) {
+                return Err(TechniqueError::unsupported(
+                    &self.name,
+                    UnsupportedReason::View(format!(
+                        "the receivers and the surfaces that can shadow them reach {reach:.1} \
+                         degrees off the light's axis; one light-centre shadow map (GBP07 \
+                         section 3) holds at most {MAX_OFF_AXIS_DEGREES} (a room around the \
+                         light, or a fixture around it, needs a sample-based technique)"
+                    )),
+                ));
+            }
+        }
         let pyramid = stats.time("min-max-pyramid", || sm.as_ref().map(MinMaxPyramid::build));
         let textured = p.light.is_textured() && self.filter.integrates_the_light();
         let domain = sm.as_ref().map(|m| {

@@ -26,8 +26,8 @@ fn every_preset_holds_the_stress_cases() {
                 );
                 limitations_seen += 1;
                 println!(
-                    "{:<24} {:<10} known limitation: {reason}",
-                    r.case, r.technique
+                    "{:<24} {:<10} known limitation: {reason} ({})",
+                    r.case, r.technique, r.detail
                 );
                 continue;
             }
