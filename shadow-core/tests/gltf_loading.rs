@@ -756,3 +756,49 @@ fn double_sided_and_zero_area_emitters_say_so() {
         }
     }
 }
+
+/// Issue 51 item 15: a 218 KB 8192 x 8192 emissive PNG took 2.9 GB as floats. Textures longer
+/// than `EMISSIVE_TEXTURE_SIDE` are box-filtered down when loaded (block means keep the light's
+/// integrals), and the file's note says so.
+#[test]
+fn an_oversized_emissive_texture_is_box_filtered_and_named() {
+    use shadow_core::load::EMISSIVE_TEXTURE_SIDE;
+    let mut w = Writer::default();
+    let grey = w.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1.0]}}));
+    // Red on the left half, blue on the right: 2 x EMISSIVE_TEXTURE_SIDE + 4 texels wide.
+    let (tw, th) = (2 * EMISSIVE_TEXTURE_SIDE + 4, 2);
+    let texels: Vec<[u8; 3]> = (0..tw * th)
+        .map(|i| if i % tw < tw / 2 { [255, 0, 0] } else { [0, 0, 255] })
+        .collect();
+    let image = w.png_image(tw, th, &texels);
+    let lamp =
+        w.material(json!({"emissiveFactor": [1.0, 1.0, 1.0], "emissiveTexture": {"index": image}}));
+    let (fp, fi) = square(3.0);
+    let floor_idx: Vec<u32> = fi.chunks(3).flat_map(|c| [c[0], c[2], c[1]]).collect();
+    w.mesh("floor", &fp, &floor_idx, None, grey);
+    let (sp, si) = square(0.5);
+    let uv = [
+        Vec2::new(0.0, 0.0),
+        Vec2::new(1.0, 0.0),
+        Vec2::new(1.0, 1.0),
+        Vec2::new(0.0, 1.0),
+    ];
+    w.mesh("big-texture-lamp", &sp, &si, Some(&uv), lamp);
+    let doc = w.document(
+        json!([{"mesh": 0}, {"mesh": 1, "translation": [0.0, 3.0, 0.0]}]),
+        json!([]),
+    );
+    let setup = load(&doc).unwrap();
+    let all = setup.warnings.join("\n");
+    // The smallest whole factor, 3, gives ceil(4100 / 3) = 1367 texels.
+    assert!(
+        all.contains("big-texture-lamp") && all.contains("4100x2 emissive texture is box-filtered to 1367x1"),
+        "{all}"
+    );
+    // Half red, half blue on average, as before filtering (one block straddles the middle).
+    let mean = setup.lights[0].radiance().mean();
+    assert!((mean - Vec3::new(0.5, 0.0, 0.5)).abs().max_element() < 2e-3, "{mean}");
+    // A texture within the side loads as it is, without a note.
+    let plain = load(&test_document()).unwrap();
+    assert!(plain.warnings.is_empty(), "{:?}", plain.warnings);
+}

@@ -10,7 +10,7 @@ mod gltf_loader;
 mod obj;
 
 pub use emissive::light_from_emissive_mesh;
-pub use gltf_loader::{glb_bytes, load_gltf, load_gltf_slice};
+pub use gltf_loader::{EMISSIVE_TEXTURE_SIDE, glb_bytes, load_gltf, load_gltf_slice};
 pub use obj::{load_obj, load_obj_slice, read_obj_mesh};
 
 use std::path::Path;
