@@ -764,11 +764,18 @@ fn double_sided_and_zero_area_emitters_say_so() {
 fn an_oversized_emissive_texture_is_box_filtered_and_named() {
     use shadow_core::load::EMISSIVE_TEXTURE_SIDE;
     let mut w = Writer::default();
-    let grey = w.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1.0]}}));
+    let grey =
+        w.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1.0]}}));
     // Red on the left half, blue on the right: 2 x EMISSIVE_TEXTURE_SIDE + 4 texels wide.
     let (tw, th) = (2 * EMISSIVE_TEXTURE_SIDE + 4, 2);
     let texels: Vec<[u8; 3]> = (0..tw * th)
-        .map(|i| if i % tw < tw / 2 { [255, 0, 0] } else { [0, 0, 255] })
+        .map(|i| {
+            if i % tw < tw / 2 {
+                [255, 0, 0]
+            } else {
+                [0, 0, 255]
+            }
+        })
         .collect();
     let image = w.png_image(tw, th, &texels);
     let lamp =
@@ -792,12 +799,16 @@ fn an_oversized_emissive_texture_is_box_filtered_and_named() {
     let all = setup.warnings.join("\n");
     // The smallest whole factor, 3, gives ceil(4100 / 3) = 1367 texels.
     assert!(
-        all.contains("big-texture-lamp") && all.contains("4100x2 emissive texture is box-filtered to 1367x1"),
+        all.contains("big-texture-lamp")
+            && all.contains("4100x2 emissive texture is box-filtered to 1367x1"),
         "{all}"
     );
     // Half red, half blue on average, as before filtering (one block straddles the middle).
     let mean = setup.lights[0].radiance().mean();
-    assert!((mean - Vec3::new(0.5, 0.0, 0.5)).abs().max_element() < 2e-3, "{mean}");
+    assert!(
+        (mean - Vec3::new(0.5, 0.0, 0.5)).abs().max_element() < 2e-3,
+        "{mean}"
+    );
     // A texture within the side loads as it is, without a note.
     let plain = load(&test_document()).unwrap();
     assert!(plain.warnings.is_empty(), "{:?}", plain.warnings);

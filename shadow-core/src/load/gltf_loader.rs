@@ -239,8 +239,12 @@ pub fn load_gltf_slice(
                                     reason: "emissive texture without texture coordinates".into(),
                                 })?;
                             let texcoords = read_vec2(&buffers, &tc_acc, limits)?;
-                            let (width, height, texels, decoded) =
-                                load_image(&doc, &buffers, info.texture().source(), base, limits)?;
+                            let LoadedImage {
+                                width,
+                                height,
+                                texels,
+                                decoded,
+                            } = load_image(&doc, &buffers, info.texture().source(), base, limits)?;
                             if decoded != (width, height) {
                                 warnings.push(format!(
                                     "mesh '{mesh_name}': its {}x{} emissive texture is \
@@ -664,7 +668,7 @@ fn load_image(
     image: gltf::Image,
     base: Option<&Path>,
     limits: &LoadLimits,
-) -> Result<(u32, u32, Vec<Vec3>, (u32, u32)), LoadError> {
+) -> Result<LoadedImage, LoadError> {
     let _ = doc;
     let bytes: Vec<u8> = match image.source() {
         gltf::image::Source::View { view, .. } => {
@@ -726,8 +730,21 @@ fn load_image(
             )
         }
     };
-    let (ow, oh, texels) = box_filtered(&img, EMISSIVE_TEXTURE_SIDE, to_linear);
-    Ok((ow, oh, texels, (w, h)))
+    let (width, height, texels) = box_filtered(&img, EMISSIVE_TEXTURE_SIDE, to_linear);
+    Ok(LoadedImage {
+        width,
+        height,
+        texels,
+        decoded: (w, h),
+    })
+}
+
+/// An emissive texture as loaded: linear RGB texels, and the size the file had.
+struct LoadedImage {
+    width: u32,
+    height: u32,
+    texels: Vec<Vec3>,
+    decoded: (u32, u32),
 }
 
 /// Longest side an emissive texture keeps: larger ones are box-filtered down to it when

@@ -29,7 +29,9 @@ pub struct LoadLimits {
     pub max_file_bytes: u64,
     /// Largest single buffer, in bytes.
     pub max_buffer_bytes: u64,
-    /// Largest vertex count over the whole scene.
+    /// Largest vertex count over the whole scene, instances flattened (each instance is a copy:
+    /// about 400 bytes a triangle once the reference or DCS has prepared it, so the default,
+    /// 2^24, keeps a scene of two triangles a vertex near 13 GB).
     pub max_vertices: u64,
     /// Largest texture, in pixels.
     pub max_image_pixels: u64,
@@ -40,7 +42,7 @@ impl Default for LoadLimits {
         Self {
             max_file_bytes: 2 << 30,
             max_buffer_bytes: 2 << 30,
-            max_vertices: 1 << 27,
+            max_vertices: 1 << 24,
             max_image_pixels: 1 << 26,
         }
     }

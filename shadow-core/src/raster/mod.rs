@@ -319,6 +319,9 @@ impl Fragments {
     }
 }
 
+/// Triangles set up at once by [`rasterize`].
+const RASTER_CHUNK: usize = 1 << 18;
+
 /// Rasterizes `triangles` (indices into `positions`) into `layers` depth layers.
 ///
 /// # Errors
@@ -333,54 +336,61 @@ pub fn rasterize(
     view.validate(layers)?;
     let (w, h) = (view.width, view.height);
     let bands = h.div_ceil(BAND) as usize;
-    // Set-up in parallel, binning in triangle order.
-    let setups: Vec<Vec<ScreenTriangle>> = triangles
-        .par_iter()
-        .map(|tri| {
-            let v = tri.map(|i| view.view_from_world.transform_point3(positions[i as usize]));
-            setup_triangle(v, view)
-        })
-        .collect();
-    let mut bins: Vec<Vec<(u32, u32)>> = vec![Vec::new(); bands];
-    for (t, subs) in setups.iter().enumerate() {
-        for (k, s) in subs.iter().enumerate() {
-            let (y0, y1) = (s.ymin / BAND, s.ymax / BAND);
-            for bin in bins.iter_mut().take(y1 as usize + 1).skip(y0 as usize) {
-                bin.push((t as u32, k as u32));
-            }
-        }
-    }
     let k = layers as usize;
     let band_len = (BAND * w) as usize * k;
     let mut tri_out = vec![NO_TRIANGLE; (w * h) as usize * k];
     let mut depth_out = vec![f32::INFINITY; (w * h) as usize * k];
-    tri_out
-        .par_chunks_mut(band_len)
-        .zip(depth_out.par_chunks_mut(band_len))
-        .enumerate()
-        .for_each(|(band, (tri_band, depth_band))| {
-            let y_lo = band as u32 * BAND;
-            let y_hi = (y_lo + BAND).min(h);
-            for &(t, sub) in &bins[band] {
-                let s = &setups[t as usize][sub as usize];
-                let ys = s.ymin.max(y_lo);
-                let ye = s.ymax.min(y_hi - 1);
-                for y in ys..=ye {
-                    for x in s.xmin..=s.xmax {
-                        let Some(d) = s.depth_at_center(x, y) else {
-                            continue;
-                        };
-                        let base = (((y - y_lo) * w + x) as usize) * k;
-                        insert_layer(
-                            &mut tri_band[base..base + k],
-                            &mut depth_band[base..base + k],
-                            t,
-                            d,
-                        );
+    // Triangles go through in chunks, in order (an equal depth keeps the earlier triangle), so
+    // the set-up data held at once stays bounded: set up whole, 8 million triangles took 3 GB.
+    for (c, chunk) in triangles.chunks(RASTER_CHUNK).enumerate() {
+        let first = (c * RASTER_CHUNK) as u32;
+        // Set-up in parallel; only the pieces that reach a pixel are kept.
+        let setups: Vec<(u32, ScreenTriangle)> = chunk
+            .par_iter()
+            .enumerate()
+            .flat_map_iter(|(i, tri)| {
+                let v = tri.map(|i| view.view_from_world.transform_point3(positions[i as usize]));
+                setup_triangle(v, view)
+                    .into_iter()
+                    .map(move |s| (first + i as u32, s))
+            })
+            .collect();
+        // Binning in triangle order.
+        let mut bins: Vec<Vec<u32>> = vec![Vec::new(); bands];
+        for (n, (_, s)) in setups.iter().enumerate() {
+            let (y0, y1) = (s.ymin / BAND, s.ymax / BAND);
+            for bin in bins.iter_mut().take(y1 as usize + 1).skip(y0 as usize) {
+                bin.push(n as u32);
+            }
+        }
+        tri_out
+            .par_chunks_mut(band_len)
+            .zip(depth_out.par_chunks_mut(band_len))
+            .enumerate()
+            .for_each(|(band, (tri_band, depth_band))| {
+                let y_lo = band as u32 * BAND;
+                let y_hi = (y_lo + BAND).min(h);
+                for &n in &bins[band] {
+                    let (t, s) = &setups[n as usize];
+                    let ys = s.ymin.max(y_lo);
+                    let ye = s.ymax.min(y_hi - 1);
+                    for y in ys..=ye {
+                        for x in s.xmin..=s.xmax {
+                            let Some(d) = s.depth_at_center(x, y) else {
+                                continue;
+                            };
+                            let base = (((y - y_lo) * w + x) as usize) * k;
+                            insert_layer(
+                                &mut tri_band[base..base + k],
+                                &mut depth_band[base..base + k],
+                                *t,
+                                d,
+                            );
+                        }
                     }
                 }
-            }
-        });
+            });
+    }
     Ok(Fragments {
         width: w,
         height: h,
@@ -451,6 +461,54 @@ mod tests {
             rasterize(&[], &[], &v, 1),
             Err(RasterError::Projection(_))
         ));
+    }
+
+    /// Triangles are set up a chunk at a time; the layers must not see the chunks: an equal
+    /// depth keeps the earlier triangle and a nearer one goes first, across chunk borders too.
+    #[test]
+    fn chunks_keep_triangle_order_and_layers() {
+        let view = ortho_view();
+        // Two copies of one square at depth 2, the second in the next chunk, one at depth 1 in
+        // the chunk after, and off-screen triangles in between.
+        let mut positions = Vec::new();
+        let mut triangles = Vec::new();
+        let square = |positions: &mut Vec<Vec3>, z: f32| {
+            let b = positions.len() as u32;
+            positions.extend([
+                Vec3::new(4.0, 4.0, z),
+                Vec3::new(28.0, 4.0, z),
+                Vec3::new(28.0, 28.0, z),
+                Vec3::new(4.0, 28.0, z),
+            ]);
+            [[b, b + 1, b + 2], [b, b + 2, b + 3]]
+        };
+        triangles.extend(square(&mut positions, -2.0));
+        let off = positions.len() as u32;
+        positions.extend([
+            Vec3::new(100.0, 100.0, -2.0),
+            Vec3::new(101.0, 100.0, -2.0),
+            Vec3::new(100.0, 101.0, -2.0),
+        ]);
+        triangles.resize(RASTER_CHUNK + 3, [off, off + 1, off + 2]);
+        let second = triangles.len() as u32;
+        triangles.extend(square(&mut positions, -2.0));
+        triangles.resize(2 * RASTER_CHUNK + 7, [off, off + 1, off + 2]);
+        let third = triangles.len() as u32;
+        triangles.extend(square(&mut positions, -1.0));
+        let f = rasterize(&positions, &triangles, &view, 3).unwrap();
+        for (x, y) in [(10, 10), (20, 25), (5, 27)] {
+            let t = f.triangle_at(x, y, 0);
+            assert!(t == third || t == third + 1, "({x}, {y}): {t}");
+            assert_eq!(f.depth_at(x, y, 0), 1.0);
+            assert!(
+                f.triangle_at(x, y, 1) < 2,
+                "({x}, {y}): {}",
+                f.triangle_at(x, y, 1)
+            );
+            assert_eq!(f.depth_at(x, y, 1), 2.0);
+            assert_eq!(f.triangle_at(x, y, 2), NO_TRIANGLE);
+        }
+        assert!(second > RASTER_CHUNK as u32 && third > 2 * RASTER_CHUNK as u32);
     }
 
     /// A perspective view of 37 x 29 pixels with the near plane at 0.1.
