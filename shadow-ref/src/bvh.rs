@@ -1,5 +1,6 @@
-//! The occlusion structure. `obvhs` builds the tree (PLOC with reinsertion) and its compressed
-//! wide BVH (CWBVH, Ylitie et al. 2017); the queries are:
+//! The occlusion structure. A binned SAH build ([`crate::sah`]) gives the binary tree, `obvhs`
+//! reinserts its nodes and compresses it into a wide BVH (CWBVH, Ylitie et al. 2017); the
+//! queries are:
 //!
 //! * binary occlusion on the wide tree (sixteen children per node) collapsed from the same
 //!   BVH2 ([`crate::wide`]),
@@ -15,30 +16,17 @@
 //! axis-aligned triangles and rays through box faces).
 
 use glam::{Vec3, Vec3A};
+use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb as BvhAabb;
 use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
-use obvhs::ploc::PlocBuilder;
 use obvhs::ray::Ray;
-use obvhs::{Boundable, BvhBuildParams};
 use shadow_core::Scene;
 
 use crate::beam::Beam;
 use crate::watertight::{ShearedRay, Triangles4};
 use crate::wide::WideBvh;
-
-#[derive(Clone, Copy)]
-struct PaddedTriangle {
-    min: Vec3A,
-    max: Vec3A,
-}
-
-impl Boundable for PaddedTriangle {
-    fn aabb(&self) -> BvhAabb {
-        BvhAabb::new(self.min, self.max)
-    }
-}
 
 /// A BVH over a scene's triangles answering occlusion queries.
 pub struct OcclusionBvh {
@@ -142,26 +130,19 @@ impl OcclusionBvh {
     pub fn build(scene: &dyn Scene) -> Self {
         let extent = scene.bounds().diagonal().max(f32::MIN_POSITIVE);
         let pad = Vec3A::splat(extent * 1e-6);
-        let prims: Vec<PaddedTriangle> = (0..scene.triangle_count())
+        // Each triangle's box, padded by its own rounding and a millionth of the scene.
+        let boxes: Vec<BvhAabb> = (0..scene.triangle_count())
             .map(|t| {
                 let [a, b, c] = scene.triangle(t).map(Vec3A::from);
                 let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
                 let slack = (hi.abs().max(lo.abs())) * 4.0 * f32::EPSILON;
-                PaddedTriangle {
-                    min: lo - pad - slack,
-                    max: hi + pad + slack,
-                }
+                BvhAabb::new(lo - pad - slack, hi + pad + slack)
             })
             .collect();
-        // obvhs's `build_cwbvh`, step by step, keeping the BVH2 for beam culling.
+        // obvhs's `build_cwbvh`, step by step, keeping the BVH2 for beam culling; the BVH2
+        // from the binned SAH build rather than PLOC (quadratic on needle fans, `crate::sah`).
         let params = BvhBuildParams::slow_build();
-        let mut bvh2 = PlocBuilder::with_capacity(prims.len()).build(
-            params.ploc_search_distance,
-            &prims,
-            (0..prims.len() as u32).collect::<Vec<_>>(),
-            params.sort_precision,
-            params.search_depth_threshold,
-        );
+        let mut bvh2 = crate::sah::build(&boxes);
         ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
         let bvh = bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false);
         let wide = WideBvh::collapse(&bvh2, WIDE_LEAF);

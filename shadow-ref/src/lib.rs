@@ -6,8 +6,8 @@
 //! point-light hard shadow.
 //!
 //! * [`beam`]: conservative beam culling of a receiver's segments to a planar light;
-//! * [`bvh`]: the occlusion structure built by `obvhs` (PLOC, CWBVH) with occlusion, any-hit
-//!   and beam queries;
+//! * [`bvh`]: the occlusion structure (binned SAH build, `obvhs` reinsertion and CWBVH) with
+//!   occlusion, any-hit and beam queries;
 //! * [`wide`]: the wide tree (sixteen SoA child boxes per node) the occlusion and beam queries
 //!   traverse;
 //! * [`watertight`]: the watertight ray-triangle test of Woop, Benthin and Wald (JCGT 2013),
@@ -37,6 +37,7 @@ pub mod bvh;
 pub mod offset;
 mod presets;
 pub mod reference;
+mod sah;
 pub mod watertight;
 pub mod wide;
 

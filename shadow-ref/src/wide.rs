@@ -1,7 +1,6 @@
 //! A wide BVH for the single-ray occlusion query and beam culling: sixteen children per node,
-//! in four SIMD groups of four, collapsed from the `obvhs` BVH2 the reference builds (PLOC with
-//! reinsertion), so the tree quality is `obvhs`'s and only the layout and traversal are the
-//! project's own.
+//! in four SIMD groups of four, collapsed from the BVH2 the reference builds (binned SAH, then
+//! `obvhs`'s reinsertion), so only the layout and traversal are new here.
 //!
 //! Why a second layout: `obvhs`'s CWBVH (Ylitie, Karras and Laine, HPG 2017) stores child boxes
 //! quantised to 8 bits, which suits a GPU's memory bandwidth; on a CPU every visited node is
