@@ -19,6 +19,7 @@ pub const AFSM_HARD: &[(&str, [f64; 5])] = &[
     ("semi-opaque", [0.0790, 0.1175, 0.0030, 0.478, 0.1861]),
     ("textured-light", [0.3703, 0.3705, 0.2980, 0.889, 0.7107]),
     ("sphere-light", [0.1284, 0.3193, -0.0046, 0.778, 0.1393]),
+    ("cornell-box", [0.1434, 0.2390, 0.0450, 0.666, 0.2258]),
 ];
 
 /// `afsm-128-lut` against the same-samples reference (the plane table's discretisation).
@@ -39,4 +40,5 @@ pub const AFSM_128_LUT: &[(&str, [f64; 5])] = &[
     ("semi-opaque", [0.0029, 0.0041, 0.0001, 0.023, 0.0000]),
     ("textured-light", [0.0035, 0.0034, 0.0001, 0.057, 0.0000]),
     ("sphere-light", [0.0034, 0.0083, 0.0001, 0.031, 0.0000]),
+    ("cornell-box", [0.0091, 0.0148, 0.0001, 0.047, 0.0000]),
 ];

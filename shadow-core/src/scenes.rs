@@ -29,7 +29,7 @@ use crate::procedural::{Mesh, cuboid, floor, grass, quad, uv_sphere};
 use crate::scene::{MeshDesc, SceneBuilder};
 
 /// Names of the built-in scenes, in a stable order.
-pub const BUILTIN_SCENES: [&str; 10] = [
+pub const BUILTIN_SCENES: [&str; 11] = [
     "quad-over-plane",
     "overlapping-occluders",
     "large-light-close",
@@ -40,13 +40,8 @@ pub const BUILTIN_SCENES: [&str; 10] = [
     "semi-opaque",
     "textured-light",
     "sphere-light",
+    "cornell-box",
 ];
-
-/// Built-in scenes that some presets are known to fail (each declares it in
-/// [`crate::preset::Preset::known_limitations`]): the stress suite runs every preset on them
-/// against the reference, `render` takes them by name, and they join [`BUILTIN_SCENES`] (and
-/// conformance) once every preset either meets a budget on them or refuses them with a reason.
-pub const STRESS_SCENES: [&str; 1] = ["cornell-box"];
 
 const BUNNY_OBJ: &[u8] = include_bytes!("../assets/models/stanford-bunny.obj");
 const SPOT_OBJ: &[u8] = include_bytes!("../assets/models/spot.obj");
@@ -71,9 +66,8 @@ pub mod quad_over_plane {
 pub enum BuiltinError {
     /// The name is not a built-in scene.
     #[error(
-        "unknown scene `{name}`; valid names: {}, {}",
-        BUILTIN_SCENES.join(", "),
-        STRESS_SCENES.join(", ")
+        "unknown scene `{name}`; valid names: {}",
+        BUILTIN_SCENES.join(", ")
     )]
     Unknown {
         /// The name asked for.

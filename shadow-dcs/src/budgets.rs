@@ -35,6 +35,7 @@ pub const DCS_64_DISCRETE: &[(&str, [f64; 5])] = &[
     ("contact", [0.0017, 0.0052, 0.0000, 0.109, 0.0001]),
     ("semi-opaque", [0.0229, 0.0341, -0.0075, 0.196, 0.0150]),
     ("textured-light", [0.0047, 0.0047, -0.0001, 0.189, 0.0003]),
+    ("cornell-box", [0.0077, 0.0128, -0.0006, 0.234, 0.0009]),
 ];
 
 /// `dcs-standard-silhouettes`.
@@ -55,6 +56,7 @@ pub const DCS_STANDARD: &[(&str, [f64; 5])] = &[
     ("semi-opaque", [0.0226, 0.0336, -0.0074, 0.145, 0.0140]),
     ("textured-light", [0.0269, 0.0269, -0.0038, 0.653, 0.0123]),
     ("sphere-light", [0.0389, 0.0737, 0.0020, 1.000, 0.0114]),
+    ("cornell-box", [0.0162, 0.0277, 0.0002, 0.359, 0.0048]),
 ];
 
 /// `dcs-64-interleaved` (tables with exact borders): semi-opaque only.

@@ -9,12 +9,12 @@ use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use shadow_core::load::{LoadLimits, load_scene};
 use shadow_core::prelude::*;
-use shadow_core::scenes::{BUILTIN_SCENES, STRESS_SCENES, builtin};
+use shadow_core::scenes::{BUILTIN_SCENES, builtin};
 
 /// A built-in scene by name, or a scene file by path. A file without an emissive mesh gets a
 /// square light above its bounds (said on stderr) unless `own_light` (the caller brings one).
 pub fn resolve_scene(name: &str, own_light: bool) -> Result<SceneSetup, String> {
-    if BUILTIN_SCENES.contains(&name) || STRESS_SCENES.contains(&name) {
+    if BUILTIN_SCENES.contains(&name) {
         return builtin(name).map_err(|e| e.to_string());
     }
     let path = Path::new(name);
@@ -104,9 +104,9 @@ pub fn list_scenes() -> Result<(), String> {
         "panels with opacity 0.3 to 0.7",
         "RGB image on a rectangle light",
         "omni-directional sphere light inside a room",
-        "open room, light recessed in a ceiling fixture, two spheres (stress suite only)",
+        "open room, light recessed in a ceiling fixture, two spheres",
     ];
-    for (name, what) in BUILTIN_SCENES.iter().chain(&STRESS_SCENES).zip(what) {
+    for (name, what) in BUILTIN_SCENES.iter().zip(what) {
         let s = builtin(name).map_err(|e| e.to_string())?;
         let comps = s.scene.topology().components();
         let closed = comps.iter().filter(|c| c.closed).count();
