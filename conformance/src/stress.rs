@@ -103,6 +103,7 @@ fn setup_of(name: &str, meshes: Vec<MeshDesc>, light: Light, camera: Camera) -> 
         camera: Some(camera),
         aspect: None,
         warnings: vec![],
+        punctual: vec![],
     }
 }
 

@@ -24,6 +24,7 @@ use crate::light::{
     AreaLight, DiskLight, Light, LightError, LightGeometry, PointLight, PolygonLight, Radiance,
     RectLight, SphereLight, TexturedRadiance,
 };
+use crate::load::punctual::PunctualLight;
 use crate::load::{LoadError, LoadLimits, SceneSetup};
 use crate::procedural::{Mesh, cuboid, floor, grass, quad, uv_sphere};
 use crate::scene::{MeshDesc, SceneBuilder};
@@ -108,6 +109,7 @@ fn finish(name: &str, parts: Parts) -> Result<SceneSetup, BuiltinError> {
         camera: Some(parts.camera),
         aspect: None,
         warnings: Vec::new(),
+        punctual: Vec::new(),
     })
 }
 
@@ -523,5 +525,14 @@ fn moved(
         camera,
         aspect: setup.aspect,
         warnings: setup.warnings.clone(),
+        punctual: setup
+            .punctual
+            .iter()
+            .map(|p| PunctualLight {
+                position: p.position * scale + translation,
+                radius: p.radius * scale,
+                ..p.clone()
+            })
+            .collect(),
     })
 }

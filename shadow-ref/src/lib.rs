@@ -37,7 +37,7 @@ pub mod bvh;
 pub mod offset;
 mod presets;
 pub mod reference;
-mod sah;
+pub mod sah;
 pub mod watertight;
 pub mod wide;
 

@@ -16,7 +16,7 @@ use obvhs::bvh2::Bvh2;
 use obvhs::bvh2::node::Bvh2Node;
 
 /// Bins per axis.
-const BINS: usize = 16;
+pub const BINS: usize = 16;
 
 /// The BVH2 over `boxes` (one per primitive, in input order): `primitive_indices` maps leaf
 /// slots to input indices.

@@ -50,6 +50,10 @@ pub struct RenderArgs {
     /// `disk:CENTER:NORMAL:RADIUS` or `sphere:CENTER:RADIUS` (points and directions `x,y,z`).
     #[arg(long)]
     light: Option<String>,
+    /// The radius of the file's `KHR_lights_punctual` point and spot lights (default: a
+    /// hundredth of the scene's diagonal).
+    #[arg(long)]
+    light_size: Option<f32>,
     /// The radiance of `--light`: `R,G,B`, or one value for all three (default 1).
     #[arg(long)]
     light_radiance: Option<String>,
@@ -89,6 +93,22 @@ const OUTPUTS: [&str; 10] = [
 
 pub fn run(a: RenderArgs) -> Result<(), String> {
     let mut setup = resolve_scene(&a.scene, a.light.is_some())?;
+    if let Some(r) = a.light_size {
+        if a.light.is_some() || setup.punctual.is_empty() {
+            return Err(format!(
+                "--light-size sizes the file's KHR_lights_punctual lights; `{}` has none{}",
+                a.scene,
+                if a.light.is_some() {
+                    " in use (--light replaces them)"
+                } else {
+                    ""
+                }
+            ));
+        }
+        setup
+            .set_punctual_radius(r)
+            .map_err(|e| format!("--light-size {r}: {e}"))?;
+    }
     if let Some(spec) = &a.light {
         let radiance = crate::overrides::radiance(a.light_radiance.as_deref())?;
         setup.lights = vec![crate::overrides::light(spec, radiance)?];

@@ -717,3 +717,75 @@ fn a_scene_far_from_the_origin_keeps_its_shadow() {
     assert!((p.0[1] - 1e6).abs() < 1.0, "{:?}", p.0);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Issue 52: a glTF file's `KHR_lights_punctual` point light is a sphere light, and
+/// `--light-size` sets its radius: a wider light gives a wider penumbra. A file without one
+/// refuses the flag.
+#[test]
+fn punctual_lights_render_and_take_a_size() {
+    let dir = temp_dir("punctual");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut doc: serde_json::Value = serde_json::from_str(&gltf_of(&[
+        (square_at(0.0, 3.0, 0.0, false), None),
+        (square_at(1.0, 0.4, 0.0, false), None),
+    ]))
+    .unwrap();
+    doc["extensionsUsed"] = serde_json::json!(["KHR_lights_punctual"]);
+    doc["extensions"] = serde_json::json!({"KHR_lights_punctual": {"lights": [{"type": "point"}]}});
+    doc["nodes"].as_array_mut().unwrap().push(serde_json::json!(
+        {"translation": [0.0, 2.0, 0.0], "extensions": {"KHR_lights_punctual": {"light": 0}}}
+    ));
+    doc["scenes"][0]["nodes"] = serde_json::json!([0, 1, 2]);
+    let file = dir.join("punctual.gltf");
+    std::fs::write(&file, doc.to_string()).unwrap();
+    let penumbra = |extra: &[&str]| {
+        let out_dir = dir.join("out");
+        let mut args = vec![
+            "render",
+            "--scene",
+            file.to_str().unwrap(),
+            "--technique",
+            "ref-64",
+            "--width",
+            "48",
+            "--camera",
+            "0,4,3:0,0,0:50",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let out = xtask(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v = image::open(out_dir.join("visibility.exr"))
+            .unwrap()
+            .to_rgba32f();
+        v.pixels()
+            .filter(|p| p.0[3] > 0.0 && p.0[0] > 0.05 && p.0[0] < 0.95)
+            .count()
+    };
+    let (small, large) = (penumbra(&[]), penumbra(&["--light-size", "0.6"]));
+    assert!(
+        large > 2 * small.max(1),
+        "penumbra pixels: default {small}, radius 0.6 {large}"
+    );
+    let out = xtask(&[
+        "render",
+        "--scene",
+        "bunny",
+        "--technique",
+        "ref-16",
+        "--width",
+        "16",
+        "--light-size",
+        "0.5",
+        "--out",
+        dir.join("bunny").to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("KHR_lights_punctual"));
+    std::fs::remove_dir_all(&dir).ok();
+}

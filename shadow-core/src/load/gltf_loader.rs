@@ -14,6 +14,7 @@ use gltf::mesh::Mode;
 use gltf::{Document, Semantic};
 
 use super::emissive::{EmissiveTexture, light_from_emissive_mesh};
+use super::texture::{EMISSIVE_TEXTURE_SIDE, box_filtered};
 use super::{LoadError, LoadLimits, SceneSetup, read_limited};
 use crate::camera::Camera;
 use crate::light::Light;
@@ -98,6 +99,7 @@ pub fn load_gltf_slice(
     // gltf-json's validation dereferences a primitive's POSITION accessor unchecked (a missing
     // one panics): every index a primitive names is checked here first.
     check_primitive_indices(gltf.document.as_json())?;
+    super::punctual::check_references(gltf.document.as_json())?;
     let doc = gltf::Document::from_json(gltf.document.into_json())
         .map_err(|e| LoadError::Gltf(e.to_string()))?;
     let buffers = load_buffers(&doc, gltf.blob, base, limits)?;
@@ -116,7 +118,6 @@ pub fn load_gltf_slice(
                     "KHR_materials_transmission" | "KHR_materials_volume" => {
                         " (transmissive materials cast opaque shadows)"
                     }
-                    "KHR_lights_punctual" => " (its lights are not used; give one with --light)",
                     "KHR_materials_unlit" => " (unlit materials are shaded and cast shadows)",
                     _ => "",
                 }
@@ -124,6 +125,7 @@ pub fn load_gltf_slice(
         }
     }
     let mut textured_albedo = Vec::new();
+    let mut punctual = Vec::new();
     let mut vertices_total = 0u64;
     let mut occluders = 0usize;
 
@@ -158,6 +160,9 @@ pub fn load_gltf_slice(
                 "node {} has a non-finite transform",
                 node.index()
             )));
+        }
+        if let Some(p) = super::punctual::on_node(doc.as_json(), node.index(), world)? {
+            punctual.push(p);
         }
         if let Some(cam) = node.camera()
             && camera.is_none()
@@ -316,6 +321,20 @@ pub fn load_gltf_slice(
     }
     let scene = builder.build()?;
     super::dropped_warning(&scene, &mut warnings);
+    // Punctual lights after the emissive meshes, in node order, sized by the scene.
+    use crate::scene::Scene;
+    let (centre, diagonal) = (scene.bounds().center(), scene.bounds().diagonal());
+    for p in &mut punctual {
+        let radius = super::punctual::DEFAULT_RADIUS_SHARE * diagonal;
+        let (light, what) = p.area_light(radius, centre, diagonal)?;
+        p.light_index = lights.len();
+        p.radius = radius;
+        lights.push(light);
+        warnings.push(format!(
+            "punctual light '{}' ({:?}) is light {}: {what}; --light-size sets the radius",
+            p.name, p.kind, p.light_index
+        ));
+    }
     Ok(SceneSetup {
         name: name.to_string(),
         scene: Arc::new(scene),
@@ -323,6 +342,7 @@ pub fn load_gltf_slice(
         camera,
         aspect,
         warnings,
+        punctual,
     })
 }
 
@@ -372,7 +392,7 @@ fn decode_data_uri(uri: &str, limit: u64) -> Result<Option<Vec<u8>>, LoadError> 
 }
 
 /// The glTF extensions whose data the loader reads.
-const HONOURED_EXTENSIONS: &[&str] = &["KHR_materials_emissive_strength"];
+const HONOURED_EXTENSIONS: &[&str] = &["KHR_materials_emissive_strength", "KHR_lights_punctual"];
 
 fn resolve(base: Option<&Path>, uri: &str) -> Result<PathBuf, LoadError> {
     let base = base.ok_or_else(|| {
@@ -745,40 +765,4 @@ struct LoadedImage {
     height: u32,
     texels: Vec<Vec3>,
     decoded: (u32, u32),
-}
-
-/// Longest side an emissive texture keeps: larger ones are box-filtered down to it when
-/// loaded. A light's radiance is integrated over regions of the light, and a block mean keeps
-/// every integral over whole blocks; an 8192 x 8192 texture (a 218 KB PNG) took 2.9 GB as
-/// floats, where 2048 x 2048 takes 64 MB (issue 51).
-pub const EMISSIVE_TEXTURE_SIDE: u32 = 2048;
-
-/// `img` as linear RGB texels (`to_linear` applied to each decoded texel before averaging),
-/// box-filtered by the smallest whole factor that brings its longest side to at most `side`
-/// (blocks at the right and bottom edges average the texels they hold). Converts a strip of
-/// rows at a time, so no full-size float copy is made.
-fn box_filtered(
-    img: &image::DynamicImage,
-    side: u32,
-    to_linear: impl Fn(Vec3) -> Vec3,
-) -> (u32, u32, Vec<Vec3>) {
-    let (w, h) = (img.width(), img.height());
-    let f = w.max(h).div_ceil(side.max(1)).max(1);
-    let (ow, oh) = (w.div_ceil(f), h.div_ceil(f));
-    let mut texels = Vec::with_capacity(ow as usize * oh as usize);
-    for by in 0..oh {
-        let (y0, rows) = (by * f, f.min(h - by * f));
-        let strip = img.crop_imm(0, y0, w, rows).to_rgb32f();
-        for bx in 0..ow {
-            let (x0, cols) = (bx * f, f.min(w - bx * f));
-            let mut sum = Vec3::ZERO;
-            for y in 0..rows {
-                for x in x0..x0 + cols {
-                    sum += to_linear(Vec3::from(strip.get_pixel(x, y).0));
-                }
-            }
-            texels.push(sum / (rows * cols) as f32);
-        }
-    }
-    (ow, oh, texels)
 }

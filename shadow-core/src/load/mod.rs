@@ -1,5 +1,6 @@
 //! Scene loading: glTF 2.0 (`.gltf` and `.glb`, embedded or external buffers, with
-//! `KHR_materials_emissive_strength`) and Wavefront OBJ, into a validated [`SceneSetup`].
+//! `KHR_materials_emissive_strength` and `KHR_lights_punctual`, [`punctual`]) and Wavefront OBJ,
+//! into a validated [`SceneSetup`].
 //!
 //! Every size a file declares is checked against [`LoadLimits`] and against the bytes actually
 //! present before anything is allocated, so malformed or hostile files give a [`LoadError`],
@@ -8,10 +9,13 @@
 mod emissive;
 mod gltf_loader;
 mod obj;
+pub mod punctual;
+mod texture;
 
 pub use emissive::light_from_emissive_mesh;
-pub use gltf_loader::{EMISSIVE_TEXTURE_SIDE, glb_bytes, load_gltf, load_gltf_slice};
+pub use gltf_loader::{glb_bytes, load_gltf, load_gltf_slice};
 pub use obj::{load_obj, load_obj_slice, read_obj_mesh};
+pub use texture::EMISSIVE_TEXTURE_SIDE;
 
 use std::path::Path;
 use std::sync::Arc;
@@ -124,9 +128,29 @@ pub struct SceneSetup {
     pub aspect: Option<f32>,
     /// Things the loader ignored (e.g. an orthographic camera), for the user to see.
     pub warnings: Vec<String>,
+    /// The file's `KHR_lights_punctual` lights; each has an area light in `lights`.
+    pub punctual: Vec<punctual::PunctualLight>,
 }
 
 impl SceneSetup {
+    /// Gives every point and spot light of the file radius `radius` (their area lights are
+    /// rebuilt; directional lights keep their angular size).
+    ///
+    /// # Errors
+    /// [`LoadError::Light`] for a radius that makes no valid light.
+    pub fn set_punctual_radius(&mut self, radius: f32) -> Result<(), LoadError> {
+        use crate::scene::Scene;
+        let b = self.scene.bounds();
+        for p in &mut self.punctual {
+            if p.kind != punctual::PunctualKind::Directional {
+                let (light, _) = p.area_light(radius, b.center(), b.diagonal())?;
+                self.lights[p.light_index] = light;
+                p.radius = radius;
+            }
+        }
+        Ok(())
+    }
+
     /// The file's camera, or one looking at the scene's bounds from the front-top.
     pub fn camera_or_default(&self) -> Camera {
         use crate::scene::Scene;

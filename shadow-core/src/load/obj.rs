@@ -48,6 +48,7 @@ pub fn load_obj_slice(
         camera: None,
         aspect: None,
         warnings,
+        punctual: Vec::new(),
     })
 }
 
