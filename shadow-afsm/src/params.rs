@@ -270,6 +270,17 @@ impl LightBounds {
                 outline: Vec::new(),
             },
             LightGeometry::Point { position } => Self::point(position),
+            // Refused by `Afsm::capabilities` (the per-sample masks assume one emitting plane
+            // or a sphere); a sphere around the mesh would still bound its influence.
+            LightGeometry::Mesh { .. } => Self {
+                kind: KIND_SPHERE,
+                center,
+                normal: Vec3::Z,
+                axes: [Vec3::X, Vec3::Y],
+                radius: 0.5 * light.bounds().diagonal(),
+                bound: 0.5 * light.bounds().diagonal(),
+                outline: Vec::new(),
+            },
         }
     }
 

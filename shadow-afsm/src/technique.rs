@@ -726,7 +726,11 @@ impl ShadowTechnique for Afsm {
     }
 
     fn capabilities(&self) -> Capabilities {
-        Capabilities::any_input(!self.hard, Processor::Gpu)
+        // Every light but meshes: the sample masks and the plane classification take one
+        // emitting plane or a sphere (section 3.1), not triangles facing many ways.
+        let mut c = Capabilities::any_input(!self.hard, Processor::Gpu);
+        c.lights.retain(|k| *k != LightKind::Mesh);
+        c
     }
 
     fn parameters(&self) -> serde_json::Value {

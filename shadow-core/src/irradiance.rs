@@ -75,7 +75,9 @@ pub fn vector_irradiance(
             ),
             normal.as_dvec3(),
         ),
-        LightGeometry::Sphere { .. } | LightGeometry::Point { .. } => return None,
+        LightGeometry::Sphere { .. } | LightGeometry::Point { .. } | LightGeometry::Mesh { .. } => {
+            return None;
+        }
     };
     // Only the light's front side emits: nothing when `p` is behind or in its plane.
     let centre = geometry_centre(geometry)?;
@@ -93,7 +95,9 @@ fn geometry_centre(g: &LightGeometry<'_>) -> Option<DVec3> {
             Some(center.as_dvec3())
         }
         LightGeometry::Polygon { outline, .. } => outline.first().map(|v| v.as_dvec3()),
-        LightGeometry::Sphere { .. } | LightGeometry::Point { .. } => None,
+        LightGeometry::Sphere { .. } | LightGeometry::Point { .. } | LightGeometry::Mesh { .. } => {
+            None
+        }
     }
 }
 

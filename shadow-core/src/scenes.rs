@@ -14,6 +14,7 @@
 //! | `textured-light` | an RGB image on a rectangle light |
 //! | `sphere-light` | an omni-directional sphere light inside a closed room |
 //! | `cornell-box` | an open five-wall room, the light recessed in a ceiling fixture, two spheres: receivers level with and behind the light, walls touching its fixture |
+//! | `mesh-light` | a folded lamp (a mesh light, its two faces emitting from their undersides) over a box and a sphere: receivers that see one face, both or none |
 
 use std::sync::Arc;
 
@@ -21,8 +22,8 @@ use glam::{Affine2, Affine3A, Vec3};
 
 use crate::camera::Camera;
 use crate::light::{
-    AreaLight, DiskLight, Light, LightError, LightGeometry, PointLight, PolygonLight, Radiance,
-    RectLight, SphereLight, TexturedRadiance,
+    AreaLight, DiskLight, Light, LightError, LightGeometry, MeshLight, PointLight, PolygonLight,
+    Radiance, RectLight, SphereLight, TexturedRadiance,
 };
 use crate::load::punctual::PunctualLight;
 use crate::load::{LoadError, LoadLimits, SceneSetup};
@@ -30,7 +31,7 @@ use crate::procedural::{Mesh, cuboid, floor, grass, quad, uv_sphere};
 use crate::scene::{MeshDesc, SceneBuilder};
 
 /// Names of the built-in scenes, in a stable order.
-pub const BUILTIN_SCENES: [&str; 11] = [
+pub const BUILTIN_SCENES: [&str; 12] = [
     "quad-over-plane",
     "overlapping-occluders",
     "large-light-close",
@@ -42,6 +43,7 @@ pub const BUILTIN_SCENES: [&str; 11] = [
     "textured-light",
     "sphere-light",
     "cornell-box",
+    "mesh-light",
 ];
 
 const BUNNY_OBJ: &[u8] = include_bytes!("../assets/models/stanford-bunny.obj");
@@ -303,6 +305,19 @@ pub fn builtin(name: &str) -> Result<SceneSetup, BuiltinError> {
             camera: cam(Vec3::new(1.6, 2.0, 1.9), Vec3::new(-0.2, 0.5, -0.3), 70.0),
         },
         "cornell-box" => cornell_box()?,
+        "mesh-light" => Parts {
+            meshes: vec![
+                mesh(floor(6.0, 0.0)),
+                mesh(cuboid(
+                    Vec3::new(-0.3, 0.9, -0.3),
+                    Vec3::new(0.3, 1.1, 0.3),
+                    false,
+                )),
+                mesh(uv_sphere(Vec3::new(1.2, 0.35, 0.4), 0.35, 16, 32)),
+            ],
+            light: Arc::new(folded_lamp::light(white(1.0))?),
+            camera: cam(Vec3::new(0.0, 3.2, 4.2), Vec3::new(0.0, 0.4, 0.0), 65.0),
+        },
         _ => {
             return Err(BuiltinError::Unknown {
                 name: name.to_string(),
@@ -310,6 +325,53 @@ pub fn builtin(name: &str) -> Result<SceneSetup, BuiltinError> {
         }
     };
     finish(name, parts)
+}
+
+/// The lamp of `mesh-light` (issue 52), exposed for checks against its faces as separate
+/// lights: a roof over the scene, its ridge at y = 2.2 along z, each face 0.4 m wide down to
+/// y = 1.8 and 1 m long, emitting from its underside (the left face toward +x, the right face
+/// toward -x).
+pub mod folded_lamp {
+    use glam::Vec3;
+
+    use crate::light::{LightError, MeshLight, Radiance, RectLight};
+
+    /// The two faces as rectangle lights (left, right).
+    ///
+    /// # Errors
+    /// Never for the constant radiances the scenes use; a texture is kept as given.
+    pub fn faces(radiance: Radiance) -> Result<[RectLight; 2], LightError> {
+        let along = Vec3::new(0.0, 0.0, 0.5);
+        Ok([
+            RectLight::new(
+                Vec3::new(-0.2, 2.0, 0.0),
+                along,
+                Vec3::new(-0.2, -0.2, 0.0),
+                radiance.clone(),
+            )?,
+            RectLight::new(
+                Vec3::new(0.2, 2.0, 0.0),
+                Vec3::new(0.2, -0.2, 0.0),
+                along,
+                radiance.clone(),
+            )?,
+        ])
+    }
+
+    /// The lamp as one mesh light: each face split into two triangles in its winding.
+    ///
+    /// # Errors
+    /// As [`faces`].
+    pub fn light(radiance: Radiance) -> Result<MeshLight, LightError> {
+        let tris: Vec<[Vec3; 3]> = faces(radiance.clone())?
+            .iter()
+            .flat_map(|f| {
+                let c = f.corners();
+                [[c[0], c[1], c[2]], [c[0], c[2], c[3]]]
+            })
+            .collect();
+        MeshLight::new(&tris, None, radiance)
+    }
 }
 
 /// `cornell-box` (issue 51): a 2 m room open at the front (+z), the ceiling at y = 2 with a
@@ -445,6 +507,13 @@ pub fn transform_light(
             Arc::new(SphereLight::new(m(center), radius * scale, r)?)
         }
         LightGeometry::Point { position } => Arc::new(PointLight::new(m(position), r)?),
+        LightGeometry::Mesh {
+            triangles,
+            texcoords,
+        } => {
+            let moved: Vec<[Vec3; 3]> = triangles.iter().map(|t| t.map(m)).collect();
+            Arc::new(MeshLight::new(&moved, texcoords, r)?)
+        }
     })
 }
 

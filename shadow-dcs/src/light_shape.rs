@@ -172,6 +172,19 @@ impl LightShape {
                     },
                 ));
             }
+            LightGeometry::Mesh { .. } => {
+                return Err(TechniqueError::unsupported(
+                    technique,
+                    UnsupportedReason::Light {
+                        kind: light.kind(),
+                        detail: Some(
+                            "a mesh light is no planar or spherical light domain: DCS's \
+                             silhouettes and wedges (sections 4.1-4.2) need one"
+                                .into(),
+                        ),
+                    },
+                ));
+            }
         };
         let radius = hull
             .iter()

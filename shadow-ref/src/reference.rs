@@ -105,6 +105,17 @@ pub(crate) struct Prepared {
     /// Shared between preparations of the same scene ([`Reference::prepare_sharing`]).
     bvh: Arc<OcclusionBvh>,
     offset: RayOffset,
+    /// Each light sample emits from the front of its own surface only (mesh lights, whose
+    /// triangles face many ways): a sample facing away from the receiver contributes nothing.
+    one_sided: bool,
+}
+
+impl Prepared {
+    /// False when light sample `y` emits nothing toward view sample `s` (see `one_sided`).
+    #[inline]
+    fn faces(&self, s: &ViewSample, y: &LightSample) -> bool {
+        !self.one_sided || (s.position - y.position).dot(y.normal) > 0.0
+    }
 }
 
 /// The ray-traced reference: a configuration ([`ShadowTechnique::prepare`] or
@@ -237,6 +248,7 @@ impl Reference {
         };
         let offset = RayOffset::for_light(&*light);
         let p = Prepared {
+            one_sided: light.kind() == LightKind::Mesh && self.source != SampleSource::Hard,
             quad,
             semi_opaque: scene.has_semi_opaque(),
             scene,
@@ -273,6 +285,7 @@ impl Reference {
                 light: o.light.clone(),
                 bvh: o.bvh.clone(),
                 offset: o.offset,
+                one_sided: o.one_sided && self.source != SampleSource::Hard,
             },
             stats,
         }
@@ -374,6 +387,10 @@ impl Reference {
         let cands = &scratch.candidates;
         let mut last = u32::MAX;
         for y in samples {
+            if !p.faces(s, y) {
+                vis.push(0.0);
+                continue;
+            }
             let Some((origin, dir, t_max)) = segment_from(origin, s, y.position) else {
                 vis.push(0.0);
                 continue;
@@ -537,7 +554,7 @@ impl PreparedReference {
             self.config
                 .pixel_samples(p.light.as_ref(), s.pixel, &mut units, &mut samples);
             let origin = p.offset.offset(s.position, s.geometric_normal);
-            for y in &samples {
+            for y in samples.iter().filter(|y| p.faces(&s, y)) {
                 if let Some((o, d, t)) = segment_from(origin, &s, y.position) {
                     out.push((o, d, t, s.triangle));
                 }

@@ -61,14 +61,16 @@ impl LightFrame {
                     .collect();
                 (normal, v)
             }
-            LightGeometry::Sphere { .. } | LightGeometry::Point { .. } => {
+            LightGeometry::Sphere { .. }
+            | LightGeometry::Point { .. }
+            | LightGeometry::Mesh { .. } => {
                 return Err(TechniqueError::unsupported(
                     technique,
                     UnsupportedReason::Light {
                         kind: light.kind(),
                         detail: Some(
                             "shadow mapping needs a planar light (its near plane is parallel \
-                             to the light, GBP07 section 3); sphere and point lights have none"
+                             to the light, GBP07 section 3); sphere, point and mesh lights have none"
                                 .into(),
                         ),
                     },

@@ -13,8 +13,18 @@ use shadow_core::scenes::{BUILTIN_SCENES, builtin};
 
 /// A built-in scene by name, or a scene file by path. A file without an emissive mesh gets a
 /// square light above its bounds (said on stderr) unless `own_light` (the caller brings one).
-pub fn resolve_scene(name: &str, own_light: bool) -> Result<SceneSetup, String> {
+/// With `emissive_as_geometry`, a file's emissive meshes load as ordinary geometry.
+pub fn resolve_scene(
+    name: &str,
+    own_light: bool,
+    emissive_as_geometry: bool,
+) -> Result<SceneSetup, String> {
     if BUILTIN_SCENES.contains(&name) {
+        if emissive_as_geometry {
+            return Err(format!(
+                "--emissive-as-geometry applies to scene files; `{name}` is a built-in scene"
+            ));
+        }
         return builtin(name).map_err(|e| e.to_string());
     }
     let path = Path::new(name);
@@ -24,7 +34,11 @@ pub fn resolve_scene(name: &str, own_light: bool) -> Result<SceneSetup, String> 
             BUILTIN_SCENES.join(", ")
         ));
     }
-    let mut setup = load_scene(path, &LoadLimits::default()).map_err(|e| e.to_string())?;
+    let limits = LoadLimits {
+        emissive_as_geometry,
+        ..LoadLimits::default()
+    };
+    let mut setup = load_scene(path, &limits).map_err(|e| e.to_string())?;
     for w in &setup.warnings {
         eprintln!("note: {w}");
     }

@@ -57,6 +57,10 @@ pub struct RenderArgs {
     /// The radiance of `--light`: `R,G,B`, or one value for all three (default 1).
     #[arg(long)]
     light_radiance: Option<String>,
+    /// Load the file's emissive meshes as ordinary geometry (occluders with their base colour)
+    /// rather than as lights.
+    #[arg(long)]
+    emissive_as_geometry: bool,
     /// A camera in place of the file's: `EYE:TARGET:FOV` (points `x,y,z`, vertical field of
     /// view in degrees, +Y up).
     #[arg(long)]
@@ -92,7 +96,7 @@ const OUTPUTS: [&str; 10] = [
 ];
 
 pub fn run(a: RenderArgs) -> Result<(), String> {
-    let mut setup = resolve_scene(&a.scene, a.light.is_some())?;
+    let mut setup = resolve_scene(&a.scene, a.light.is_some(), a.emissive_as_geometry)?;
     if let Some(r) = a.light_size {
         if a.light.is_some() || setup.punctual.is_empty() {
             return Err(format!(

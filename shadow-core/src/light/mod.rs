@@ -1,6 +1,7 @@
 //! Area lights (DESIGN section 3): the [`AreaLight`] trait and its shapes, rectangle, disk,
-//! polygon (convex or concave, triangulated with `spade`), sphere (omni-directional) and the
-//! point light as the zero-size limit, each with constant or textured radiance.
+//! polygon (convex or concave, triangulated with `spade`), sphere (omni-directional), the
+//! point light as the zero-size limit, and the emissive triangle mesh of any shape
+//! ([`MeshLight`]), each with constant or textured radiance.
 //!
 //! Every light maps the unit square area-uniformly onto its surface ([`AreaLight::sample`]), so
 //! a stratified pattern in the unit square stays stratified on the light (DCS section 5).
@@ -13,10 +14,12 @@
 //!   parametrises omni-directional lights in 2D): `V(p)` is the fraction of its whole surface
 //!   visible through the scene, while only the half facing `p` contributes to direct illumination.
 
+mod mesh;
 mod polygon;
 mod radiance;
 mod shapes;
 
+pub use mesh::MeshLight;
 pub use polygon::PolygonLight;
 pub use radiance::{Radiance, TexturedRadiance};
 pub use shapes::{DiskLight, PointLight, RectLight, SphereLight};
@@ -117,6 +120,14 @@ pub enum LightGeometry<'a> {
         /// Position.
         position: Vec3,
     },
+    /// An emissive triangle mesh of any shape ([`MeshLight`]): each triangle emits from its
+    /// front (counter-clockwise) side.
+    Mesh {
+        /// The emitting triangles in world space.
+        triangles: &'a [[Vec3; 3]],
+        /// Texture coordinates per triangle corner, when the radiance is a texture.
+        texcoords: Option<&'a [[Vec2; 3]]>,
+    },
 }
 
 /// Which family a light belongs to, for capability checks.
@@ -132,16 +143,19 @@ pub enum LightKind {
     Sphere,
     /// [`PointLight`].
     Point,
+    /// [`MeshLight`].
+    Mesh,
 }
 
 impl LightKind {
     /// Every family, for techniques that take them all.
-    pub const ALL: [LightKind; 5] = [
+    pub const ALL: [LightKind; 6] = [
         LightKind::Rectangle,
         LightKind::Disk,
         LightKind::Polygon,
         LightKind::Sphere,
         LightKind::Point,
+        LightKind::Mesh,
     ];
 }
 
@@ -154,18 +168,20 @@ impl LightGeometry<'_> {
             Self::Polygon { .. } => LightKind::Polygon,
             Self::Sphere { .. } => LightKind::Sphere,
             Self::Point { .. } => LightKind::Point,
+            Self::Mesh { .. } => LightKind::Mesh,
         }
     }
 
     /// The plane a one-sided (planar) light emits from: a point on it and its unit normal,
-    /// the side light leaves by. `None` for spheres and points, which emit all around.
+    /// the side light leaves by. `None` for spheres and points, which emit all around, and for
+    /// meshes, whose triangles face many ways.
     pub fn emitting_plane(&self) -> Option<(Vec3, Vec3)> {
         match *self {
             Self::Rectangle { center, normal, .. } | Self::Disk { center, normal, .. } => {
                 Some((center, normal))
             }
             Self::Polygon { outline, normal } => outline.first().map(|p| (*p, normal)),
-            Self::Sphere { .. } | Self::Point { .. } => None,
+            Self::Sphere { .. } | Self::Point { .. } | Self::Mesh { .. } => None,
         }
     }
 
@@ -183,7 +199,7 @@ impl LightGeometry<'_> {
 
     /// A bounding rectangle of a planar light in its own plane, corners in order: the
     /// rectangle itself, the square around a disk, the bounding rectangle of a polygon. `None`
-    /// for spheres and points.
+    /// for spheres, points and meshes.
     pub fn bounding_quad(&self) -> Option<[Vec3; 4]> {
         let quad = |o: Vec3, t: Vec3, b: Vec3, lo: glam::Vec2, hi: glam::Vec2| {
             let at = |x: f32, y: f32| o + t * x + b * y;
@@ -224,17 +240,17 @@ impl LightGeometry<'_> {
                 }
                 Some(quad(o, t, b, lo, hi))
             }
-            Self::Sphere { .. } | Self::Point { .. } => None,
+            Self::Sphere { .. } | Self::Point { .. } | Self::Mesh { .. } => None,
         }
     }
 
-    /// The plane normal of planar lights, `None` for spheres and points.
+    /// The plane normal of planar lights, `None` for spheres, points and meshes.
     pub fn plane_normal(&self) -> Option<Vec3> {
         match *self {
             Self::Rectangle { normal, .. }
             | Self::Disk { normal, .. }
             | Self::Polygon { normal, .. } => Some(normal),
-            Self::Sphere { .. } | Self::Point { .. } => None,
+            Self::Sphere { .. } | Self::Point { .. } | Self::Mesh { .. } => None,
         }
     }
 }

@@ -1,7 +1,9 @@
-//! Turning an emissive triangle mesh into an exact area light: planar meshes become rectangle,
-//! disk or polygon lights (rectangles and disks recognised exactly), a closed mesh whose
-//! vertices lie on a sphere becomes a sphere light; anything else is a clear
-//! [`LoadError::Unsupported`] naming the mesh.
+//! Turning an emissive triangle mesh into an area light: planar meshes with one outline become
+//! rectangle, disk or polygon lights (rectangles and disks recognised exactly), a closed mesh
+//! whose vertices lie on a sphere becomes a sphere light, and any other shape (bent, with
+//! holes, in pieces, double-sided, or textured in a way the exact shapes cannot map) becomes a
+//! [`MeshLight`] (issue 52), which the reference and `ref-adaptive` render and the other
+//! techniques refuse by name. Only a mesh with no area at all is an error.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -11,7 +13,8 @@ use glam::{Affine2, DVec3, Mat2, Vec2, Vec3};
 use super::LoadError;
 use crate::geometry::{Aabb, triangle_cross_f64};
 use crate::light::{
-    DiskLight, Light, LightError, PolygonLight, Radiance, RectLight, SphereLight, TexturedRadiance,
+    DiskLight, Light, LightError, MeshLight, PolygonLight, Radiance, RectLight, SphereLight,
+    TexturedRadiance,
 };
 
 /// An emissive texture with the mesh's texture coordinates (per input vertex).
@@ -37,9 +40,8 @@ enum Shape {
 /// Builds the light an emissive mesh describes (positions in world space).
 ///
 /// # Errors
-/// [`LoadError::Unsupported`] for shapes that are no rectangle, disk, simple polygon or sphere,
-/// for holes, and for textures on spheres or with a non-affine mapping; [`LoadError::Light`]
-/// when the recognised shape is invalid.
+/// [`LoadError::Unsupported`] for a mesh without area and a texture without texture
+/// coordinates; [`LoadError::Light`] when the light is invalid (a negative radiance).
 pub fn light_from_emissive_mesh(
     name: &str,
     positions: &[Vec3],
@@ -97,22 +99,29 @@ pub fn light_from_emissive_mesh(
             .iter()
             .all(|p| (p.as_dvec3() - centroid).dot(nn).abs() <= 1e-4 * diag)
     };
+    if !(abs_area > 0.0) {
+        return Err(unsupported(
+            "emissive mesh has no area: every triangle is degenerate",
+        ));
+    }
+    let as_mesh = |texture| mesh_light(name, positions, triangles, emission, texture);
     let shape = if planar {
         let normal = n.normalize().as_vec3();
-        let loops = boundary.map_err(|r| unsupported(&r))?;
-        if loops.len() != 1 {
-            return Err(unsupported(&format!(
-                "planar emissive mesh has {} boundary loops (holes or several pieces)",
-                loops.len()
-            )));
+        let outline = match boundary {
+            Ok(loops) if loops.len() == 1 => simplify(
+                &loops[0]
+                    .iter()
+                    .map(|&v| welded[v as usize])
+                    .collect::<Vec<_>>(),
+            ),
+            // Holes, several pieces, a boundary touching itself: any shape is a mesh light.
+            _ => return as_mesh(texture),
+        };
+        match planar_shape(&outline, normal, constant.clone()) {
+            Ok(shape) => shape,
+            Err(LightError::InvalidPolygon(_)) => return as_mesh(texture),
+            Err(e) => return Err(light_err(e)),
         }
-        let outline = simplify(
-            &loops[0]
-                .iter()
-                .map(|&v| welded[v as usize])
-                .collect::<Vec<_>>(),
-        );
-        planar_shape(&outline, normal, constant.clone()).map_err(light_err)?
     } else {
         let closed = matches!(&boundary, Ok(l) if l.is_empty());
         let dists: Vec<f64> = welded
@@ -147,26 +156,20 @@ pub fn light_from_emissive_mesh(
                     .all(|p| (p.as_dvec3() - o).dot(nn).abs() <= 1e-4 * diag)
             }
         });
-        if !(abs_area > 0.0) {
-            return Err(unsupported(
-                "emissive mesh has no area: every triangle is degenerate",
-            ));
-        } else if flat_both_ways {
-            return Err(unsupported(
-                "emissive mesh is flat but its triangles face both ways (double-sided, or wound \
-                 inconsistently): a planar light emits from one side, so keep one side with \
-                 one winding",
-            ));
-        } else if closed && welded.len() >= 6 && dists.iter().all(|d| (d - r).abs() <= 2e-3 * r) {
+        if !flat_both_ways
+            && texture.is_none()
+            && closed
+            && welded.len() >= 6
+            && dists.iter().all(|d| (d - r).abs() <= 2e-3 * r)
+        {
             Shape::Sphere(
                 SphereLight::new(centroid.as_vec3(), r as f32, constant.clone())
                     .map_err(light_err)?,
             )
         } else {
-            return Err(unsupported(
-                "emissive mesh is neither planar nor a closed sphere; only rectangle, disk, \
-                 polygon and sphere lights are supported",
-            ));
+            // Bent, or flat with triangles facing both ways (a double-sided card emits from
+            // both sides, each triangle from its front).
+            return as_mesh(texture);
         }
     };
     let radiance = match texture {
@@ -177,9 +180,7 @@ pub fn light_from_emissive_mesh(
                     Shape::Rect(l) => Ok(l.uv_of(p)),
                     Shape::Disk(l) => Ok(l.uv_of(p)),
                     Shape::Polygon(l) => Ok(l.uv_of(p)),
-                    Shape::Sphere(_) => {
-                        Err(unsupported("textured sphere lights are not supported"))
-                    }
+                    Shape::Sphere(_) => unreachable!("textured emitters are never spheres"),
                 }
             };
             if tex.texcoords.len() != positions.len() {
@@ -189,9 +190,10 @@ pub fn light_from_emissive_mesh(
                 .iter()
                 .map(|p| uv_of(*p))
                 .collect::<Result<Vec<_>, _>>()?;
-            let map = fit_affine(triangles, &light_uv, &tex.texcoords).ok_or_else(|| {
-                unsupported("the emissive texture is not an affine map over the light")
-            })?;
+            let Some(map) = fit_affine(triangles, &light_uv, &tex.texcoords) else {
+                // Not one affine map over the exact shape: each triangle keeps its own.
+                return as_mesh(Some(tex));
+            };
             Radiance::Textured(
                 TexturedRadiance::new(tex.width, tex.height, tex.texels, emission, map)
                     .map_err(light_err)?,
@@ -205,6 +207,57 @@ pub fn light_from_emissive_mesh(
         Shape::Sphere(l) => Arc::new(l),
     };
     Ok(light)
+}
+
+/// The emissive mesh as a [`MeshLight`]: every triangle of area, in its winding, with its
+/// texture coordinates when the emission is a texture.
+fn mesh_light(
+    name: &str,
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    emission: Vec3,
+    texture: Option<EmissiveTexture>,
+) -> Result<Light, LoadError> {
+    let light_err = |source: LightError| LoadError::Light {
+        mesh: name.to_string(),
+        source,
+    };
+    let tris: Vec<[Vec3; 3]> = triangles
+        .iter()
+        .map(|t| t.map(|v| positions[v as usize]))
+        .collect();
+    let light = match texture {
+        None => MeshLight::new(
+            &tris,
+            None,
+            Radiance::constant(emission).map_err(light_err)?,
+        ),
+        Some(tex) => {
+            if tex.texcoords.len() != positions.len() {
+                return Err(LoadError::Unsupported {
+                    mesh: name.to_string(),
+                    reason: "emissive texture without texture coordinates".into(),
+                });
+            }
+            let tc: Vec<[Vec2; 3]> = triangles
+                .iter()
+                .map(|t| t.map(|v| tex.texcoords[v as usize]))
+                .collect();
+            let radiance = Radiance::Textured(
+                TexturedRadiance::new(
+                    tex.width,
+                    tex.height,
+                    tex.texels,
+                    emission,
+                    Affine2::IDENTITY,
+                )
+                .map_err(light_err)?,
+            );
+            MeshLight::new(&tris, Some(&tc), radiance)
+        }
+    }
+    .map_err(light_err)?;
+    Ok(Arc::new(light))
 }
 
 /// Directed boundary loops (edges used by exactly one triangle), following the winding.

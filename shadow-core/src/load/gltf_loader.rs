@@ -230,7 +230,7 @@ pub fn load_gltf_slice(
                 let material = prim.material();
                 let strength = material.emissive_strength().unwrap_or(1.0);
                 let emission = Vec3::from(material.emissive_factor()) * strength;
-                if emission.max_element() > 0.0 {
+                if emission.max_element() > 0.0 && !limits.emissive_as_geometry {
                     let world_pos: Vec<Vec3> = positions
                         .iter()
                         .map(|p| world.transform_point3(*p))
@@ -267,9 +267,18 @@ pub fn load_gltf_slice(
                         }
                         None => None,
                     };
-                    lights.push(light_from_emissive_mesh(
+                    let light = light_from_emissive_mesh(
                         &mesh_name, &world_pos, &triangles, emission, texture,
-                    )?);
+                    )?;
+                    if light.kind() == crate::light::LightKind::Mesh {
+                        warnings.push(format!(
+                            "mesh '{mesh_name}': emissive but not one planar outline or a \
+                             sphere, so a mesh light (each triangle emits from its front; \
+                             only the reference techniques render it; \
+                             --emissive-as-geometry loads it as geometry)"
+                        ));
+                    }
+                    lights.push(light);
                     continue;
                 }
                 let pbr = material.pbr_metallic_roughness();

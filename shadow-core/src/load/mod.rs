@@ -26,7 +26,8 @@ use crate::camera::{Camera, CameraError};
 use crate::light::{Light, LightError};
 use crate::scene::{SceneError, TriangleScene};
 
-/// Upper bounds on what a file may make the loader allocate.
+/// Upper bounds on what a file may make the loader allocate, and the one choice a loader makes
+/// about a file's content (what an emissive mesh is).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct LoadLimits {
     /// Largest file read, in bytes.
@@ -39,6 +40,9 @@ pub struct LoadLimits {
     pub max_vertices: u64,
     /// Largest texture, in pixels.
     pub max_image_pixels: u64,
+    /// Load emissive meshes as ordinary geometry (occluders and receivers with their base
+    /// colour) instead of as lights; a file left with no light then gets the default light.
+    pub emissive_as_geometry: bool,
 }
 
 impl Default for LoadLimits {
@@ -48,6 +52,7 @@ impl Default for LoadLimits {
             max_buffer_bytes: 2 << 30,
             max_vertices: 1 << 24,
             max_image_pixels: 1 << 26,
+            emissive_as_geometry: false,
         }
     }
 }
