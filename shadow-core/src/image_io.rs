@@ -43,11 +43,19 @@ fn save_rgba32(
         })
 }
 
-fn save_rgb8(path: &Path, w: u32, h: u32, f: impl Fn(usize) -> Vec3) -> Result<(), ImageError> {
-    let img = RgbImage::from_fn(w, h, |x, y| {
+/// An 8-bit sRGB image of the linear colours `f(pixel index)`.
+fn rgb8(w: u32, h: u32, f: impl Fn(usize) -> Vec3) -> RgbImage {
+    RgbImage::from_fn(w, h, |x, y| {
         let c = f((y * w + x) as usize);
         Rgb(c.to_array().map(|v| (srgb_encode(v) * 255.0 + 0.5) as u8))
-    });
+    })
+}
+
+fn save_rgb8(path: &Path, w: u32, h: u32, f: impl Fn(usize) -> Vec3) -> Result<(), ImageError> {
+    save_png(path, &rgb8(w, h, f))
+}
+
+fn save_png(path: &Path, img: &RgbImage) -> Result<(), ImageError> {
     img.save_with_format(path, ImageFormat::Png)
         .map_err(|source| ImageError::Write {
             path: path.display().to_string(),
@@ -217,8 +225,7 @@ pub fn write_error_png(
     })
 }
 
-/// Writes a shaded view: albedo x V x cos(shading normal, direction to the light centre),
-/// scaled by the light's mean radiance normalised to its largest channel.
+/// Writes a shaded view ([`shaded_image`]) as a PNG.
 ///
 /// # Errors
 /// [`ImageError`] on size mismatch or write failure.
@@ -229,6 +236,21 @@ pub fn write_shaded_png(
     light: &dyn AreaLight,
     v: &dyn VisibilityBuffer,
 ) -> Result<(), ImageError> {
+    save_png(path, &shaded_image(scene, view, light, v)?)
+}
+
+/// A shaded view in 8-bit sRGB: albedo x V x cos(shading normal, direction to the light
+/// centre), scaled by the light's mean radiance normalised to its largest channel. The images
+/// the conformance report compares with FLIP.
+///
+/// # Errors
+/// [`ImageError::Size`] when `v` and `view` differ in size.
+pub fn shaded_image(
+    scene: &dyn Scene,
+    view: &ViewSamples,
+    light: &dyn AreaLight,
+    v: &dyn VisibilityBuffer,
+) -> Result<RgbImage, ImageError> {
     if v.width() != view.width() || v.height() != view.height() {
         return Err(ImageError::Size);
     }
@@ -240,7 +262,7 @@ pub fn write_shaded_png(
             Vec3::ONE
         }
     };
-    save_rgb8(path, view.width(), view.height(), |i| match view.get(i) {
+    Ok(rgb8(view.width(), view.height(), |i| match view.get(i) {
         Some(s) => {
             let l = (light.center() - s.position).normalize_or_zero();
             let cos = s.shading_normal.dot(l).max(0.0);
@@ -252,7 +274,7 @@ pub fn write_shaded_png(
             scene.albedo(s.triangle as usize) * vis * cos + Vec3::splat(0.02)
         }
         None => BACKGROUND,
-    })
+    }))
 }
 
 #[cfg(test)]

@@ -52,7 +52,11 @@ pub enum UnsupportedReason {
 impl std::fmt::Display for UnsupportedReason {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            Self::Light { kind, detail: None } => write!(f, "{kind:?} lights are not supported"),
+            Self::Light { kind, detail: None } => write!(
+                f,
+                "{} lights are not supported",
+                format!("{kind:?}").to_lowercase()
+            ),
             Self::Light {
                 detail: Some(d), ..
             } => f.write_str(d),
@@ -576,7 +580,7 @@ mod tests {
         );
         assert_eq!(
             e.to_string(),
-            "x does not support this input: Sphere lights are not supported"
+            "x does not support this input: sphere lights are not supported"
         );
         assert!(matches!(
             e.unsupported_reason(),

@@ -13,6 +13,7 @@ use glam::Vec3;
 use serde::Serialize;
 use serde_json::json;
 use shadow_conformance::conformance::run_technique;
+use shadow_core::image_io::shaded_image;
 use shadow_core::metrics::compare;
 use shadow_core::prelude::*;
 use shadow_core::procedural::{floor, uv_sphere};
@@ -21,6 +22,7 @@ use shadow_ref::Reference;
 
 use crate::common::{machine, progress, rays_per_second_per_thread, write_json};
 use crate::ensure_dir;
+use crate::flip::flip;
 use crate::plot::{Series, log_log, pareto_front};
 
 #[derive(Args)]
@@ -62,6 +64,8 @@ struct Point {
     samples: Option<u32>,
     rmse: f64,
     penumbra_rmse: Option<f64>,
+    /// Mean FLIP of the shaded image against the ground truth's ([`crate::flip`]).
+    flip: f64,
     bias: f64,
     max_abs: f64,
     seconds: f64,
@@ -222,18 +226,30 @@ pub fn run(a: BenchArgs) -> Result<(), String> {
             .map_err(|e| e.to_string())?
             .0
             .visibility;
+        let shade = |v: &VisibilityImage| {
+            shaded_image(
+                setup.scene.as_ref(),
+                &view,
+                setup.lights[0].as_ref(),
+                v,
+            )
+            .map_err(|e| e.to_string())
+        };
+        let truth_shaded = shade(&truth)?;
         let mut record = |technique: &str,
                           samples: Option<u32>,
                           make: &dyn Fn() -> Box<dyn ShadowTechnique>|
          -> Result<(), String> {
             let (secs, runs, est) = timed(make, &setup, &view, a.repeats)?;
             let mt = compare(&est.visibility, &truth).map_err(|e| e.to_string())?;
+            let perceptual = flip(&truth_shaded, &shade(&est.visibility)?, &view)?;
             points.push(Point {
                 scene: scene.clone(),
                 technique: technique.into(),
                 samples,
                 rmse: mt.rmse,
                 penumbra_rmse: mt.penumbra_rmse,
+                flip: perceptual.mean,
                 bias: mt.bias,
                 max_abs: mt.max_abs,
                 seconds: secs,
@@ -401,18 +417,19 @@ pub fn run(a: BenchArgs) -> Result<(), String> {
 
     // Files.
     let mut csv = format!(
-        "# {} | {} threads | {} | {}x{} | ground truth: reference at {truth_samples} samples\nscene,technique,samples,rmse,penumbra_rmse,bias,max_abs,seconds_median\n",
+        "# {} | {} threads | {} | {}x{} | ground truth: reference at {truth_samples} samples\nscene,technique,samples,rmse,penumbra_rmse,flip,bias,max_abs,seconds_median\n",
         m.cpu, m.threads, m.date, a.width, a.height
     );
     for p in &points {
         writeln!(
             csv,
-            "{},{},{},{:.6},{},{:.6},{:.5},{:.5}",
+            "{},{},{},{:.6},{},{:.6},{:.6},{:.5},{:.5}",
             p.scene,
             p.technique,
             p.samples.map_or(String::new(), |s| s.to_string()),
             p.rmse,
             p.penumbra_rmse.map_or(String::new(), |v| format!("{v:.6}")),
+            p.flip,
             p.bias,
             p.max_abs,
             p.seconds

@@ -107,7 +107,8 @@ pub fn list_scenes() -> Result<(), String> {
         "{:<24} {:>9} {:>8} {:<10} what it exercises",
         "scene", "triangles", "closed", "light"
     );
-    let what = [
+    // One line per built-in scene, in order (a new scene without one does not compile).
+    let what: [&str; BUILTIN_SCENES.len()] = [
         "square light over a parallel square occluder (closed form)",
         "penumbra fusion of overlapping occluders (survey Fig. 6)",
         "large light close to a small occluder (survey Fig. 7)",
@@ -119,6 +120,7 @@ pub fn list_scenes() -> Result<(), String> {
         "RGB image on a rectangle light",
         "omni-directional sphere light inside a room",
         "open room, light recessed in a ceiling fixture, two spheres",
+        "folded mesh light (two one-sided faces) over a box and a sphere",
     ];
     for (name, what) in BUILTIN_SCENES.iter().zip(what) {
         let s = builtin(name).map_err(|e| e.to_string())?;

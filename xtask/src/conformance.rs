@@ -1,6 +1,8 @@
 //! `cargo xtask conformance`: the main job. Every preset on every supported built-in scene,
-//! against the reference on the same view samples; a table, `report.md`, `report.json` and per
-//! case images (visibility, signed error, shaded).
+//! against the reference on the same view samples; a table, `report.md`, `report.json`,
+//! `report.html` (self-contained: every image and a time-error plot per scene, [`crate::html`])
+//! and per case images (visibility, signed error, shaded, FLIP map). FLIP ([`crate::flip`])
+//! compares each shaded image with the reference's.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -11,12 +13,26 @@ use shadow_conformance::conformance::{
     BUDGET_RESOLUTION, Outcome, SceneContext, SuiteConfig, reference_curve, reference_time_at,
     run_case,
 };
-use shadow_core::image_io::{write_error_png, write_shaded_png, write_visibility_png};
+use shadow_core::image_io::{shaded_image, write_error_png, write_visibility_png};
 use shadow_core::metrics::compare;
 use shadow_core::scenes::{BUILTIN_SCENES, builtin};
 
 use crate::common::{machine, progress, write_json};
 use crate::ensure_dir;
+use crate::flip::flip;
+use crate::html::{self, Picture};
+
+fn picture(caption: &str, path: PathBuf) -> Picture {
+    Picture {
+        caption: caption.into(),
+        path,
+    }
+}
+
+fn save(img: &image::RgbImage, path: &std::path::Path) -> Result<(), String> {
+    img.save(path)
+        .map_err(|e| format!("writing {}: {e}", path.display()))
+}
 
 #[derive(Args)]
 pub struct ConformanceArgs {
@@ -86,7 +102,8 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
     let m = machine();
     writeln!(md, "# Conformance report\n\n{} x {} pixels, reference {} samples per pixel, seed {}. Machine: {} ({} threads), {}.\n", a.width, a.height, a.ref_samples, a.seed, m.cpu, m.threads, m.date).ok();
     writeln!(md, "Speed-up: the reference's time at the technique's RMSE against the independent reference (the stratified reference at {} samples with its own seed, never the same-samples one a sample-based technique's budget is checked against), by log-log interpolation of the reference at {CURVE:?} samples measured against the same independent reference, divided by the technique's time; `>` when the technique beats every reference run.\n", a.ref_samples).ok();
-    writeln!(md, "| technique | scene | RMSE | penumbra RMSE | bias | max | share > 0.1 | phases (s) | speed-up | status |\n|---|---|---|---|---|---|---|---|---|---|").ok();
+    writeln!(md, "FLIP: the mean FLIP (NVIDIA's perceptual difference, Andersson et al. 2020, at 67 pixels per degree) of the technique's shaded image against the reference's, over the pixels holding a view sample.\n").ok();
+    writeln!(md, "| technique | scene | RMSE | penumbra RMSE | FLIP | bias | max | share > 0.1 | phases (s) | speed-up | status |\n|---|---|---|---|---|---|---|---|---|---|---|").ok();
     // The first column fits the longest preset name.
     let name_width = chosen
         .iter()
@@ -95,9 +112,19 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
         .unwrap_or(9)
         .max(9);
     println!(
-        "{:<name_width$} {:<22} {:>8} {:>8} {:>8} {:>6} {:>7} {:>28} {:>9}  status",
-        "technique", "scene", "RMSE", "pen.RMSE", "bias", "max", ">0.1", "phases (s)", "speed-up"
+        "{:<name_width$} {:<22} {:>8} {:>8} {:>7} {:>8} {:>6} {:>7} {:>28} {:>9}  status",
+        "technique",
+        "scene",
+        "RMSE",
+        "pen.RMSE",
+        "FLIP",
+        "bias",
+        "max",
+        ">0.1",
+        "phases (s)",
+        "speed-up"
     );
+    let mut html_scenes = Vec::new();
     for scene in &scenes {
         pb.set_message(format!("{scene}: reference"));
         let ctx = SceneContext::new(builtin(scene).map_err(|e| e.to_string())?, cfg)?;
@@ -106,14 +133,32 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
         ensure_dir(&dir)?;
         let (reference, ref_secs) = ctx.reference()?;
         write_visibility_png(&dir.join("reference.png"), reference).map_err(|e| e.to_string())?;
-        write_shaded_png(
-            &dir.join("reference-shaded.png"),
-            ctx.setup.scene.as_ref(),
-            &ctx.view,
-            ctx.light().as_ref(),
-            reference,
-        )
-        .map_err(|e| e.to_string())?;
+        let shade = |v: &dyn shadow_core::visibility::VisibilityBuffer| {
+            shaded_image(ctx.setup.scene.as_ref(), &ctx.view, ctx.light().as_ref(), v)
+                .map_err(|e| e.to_string())
+        };
+        let reference_shaded = shade(reference)?;
+        save(&reference_shaded, &dir.join("reference-shaded.png"))?;
+        let mut html_scene = html::Scene {
+            name: scene.to_string(),
+            reference: vec![
+                picture("visibility", dir.join("reference.png")),
+                picture("shaded", dir.join("reference-shaded.png")),
+            ],
+            curve: curve.iter().map(|c| (c.seconds, c.rmse)).collect(),
+            cases: Vec::new(),
+        };
+        let html_case = |technique: &str, status: String| html::Case {
+            technique: technique.to_string(),
+            status,
+            rmse: None,
+            penumbra_rmse: None,
+            flip: None,
+            seconds: None,
+            independent_rmse: None,
+            speedup: String::new(),
+            pictures: Vec::new(),
+        };
         pb.inc(1);
         for p in &chosen {
             pb.set_message(format!("{scene}: {}", p.name));
@@ -132,6 +177,9 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
                     )
                     .ok();
                     rows.push(json!({"technique": p.name, "scene": scene, "status": "unsupported", "reason": reason}));
+                    html_scene
+                        .cases
+                        .push(html_case(p.name, format!("unsupported: {reason}")));
                 }
                 Outcome::Failed { error } => {
                     println!("{:<name_width$} {:<22} FAILED: {error}", p.name, scene);
@@ -143,6 +191,9 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
                     .ok();
                     failures.push(format!("{} on {scene}: {error}", p.name));
                     rows.push(json!({"technique": p.name, "scene": scene, "status": "failed", "error": error}));
+                    html_scene
+                        .cases
+                        .push(html_case(p.name, format!("FAILED: {error}")));
                 }
                 Outcome::Ran(r) => {
                     let case_dir = dir.join(p.name);
@@ -151,14 +202,10 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
                         .map_err(|e| e.to_string())?;
                     write_error_png(&case_dir.join("error.png"), &r.estimate, &r.reference, 0.5)
                         .map_err(|e| e.to_string())?;
-                    write_shaded_png(
-                        &case_dir.join("shaded.png"),
-                        ctx.setup.scene.as_ref(),
-                        &ctx.view,
-                        ctx.light().as_ref(),
-                        &r.estimate,
-                    )
-                    .map_err(|e| e.to_string())?;
+                    let shaded = shade(&r.estimate)?;
+                    save(&shaded, &case_dir.join("shaded.png"))?;
+                    let perceptual = flip(&reference_shaded, &shaded, &ctx.view)?;
+                    save(&perceptual.map, &case_dir.join("flip.png"))?;
                     let phases = r
                         .prepare_stats
                         .phases
@@ -205,6 +252,7 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
                         scene.to_string(),
                         format!("{:.4}", r.metrics.rmse),
                         pen,
+                        format!("{:.4}", perceptual.mean),
                         format!("{:+.4}", r.metrics.bias),
                         format!("{:.3}", r.metrics.max_abs),
                         format!("{:.4}", r.metrics.share_over_0_1),
@@ -212,7 +260,7 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
                         speedup,
                         status,
                     ];
-                    let widths = [name_width, 22, 8, 8, 8, 6, 7, 28, 9, 0];
+                    let widths = [name_width, 22, 8, 8, 7, 8, 6, 7, 28, 9, 0];
                     let line: Vec<String> = cells
                         .iter()
                         .zip(widths)
@@ -230,17 +278,40 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
                     let mut row = serde_json::to_value(&*r).map_err(|e| e.to_string())?;
                     row["status"] = json!(if r.passed() { "ok" } else { "fail" });
                     row["rmse_against_independent_reference"] = json!(independent_rmse);
+                    row["flip"] = json!(perceptual.mean);
                     row["speedup_at_equal_error"] =
                         json!(reference_time_at(&curve, independent_rmse).map(|t| t / r.seconds));
                     row["reference_curve"] = json!(curve);
                     row["reference_seconds_high"] = json!(ref_secs);
                     rows.push(row);
+                    let mut case = html_case(p.name, cells[cells.len() - 1].clone());
+                    case.rmse = Some(r.metrics.rmse);
+                    case.penumbra_rmse = r.metrics.penumbra_rmse;
+                    case.flip = Some(perceptual.mean);
+                    case.seconds = Some(r.seconds);
+                    case.independent_rmse = Some(independent_rmse);
+                    case.speedup = cells[cells.len() - 2].clone();
+                    case.pictures = ["visibility", "error", "shaded", "flip"]
+                        .iter()
+                        .map(|n| picture(n, case_dir.join(format!("{n}.png"))))
+                        .collect();
+                    html_scene.cases.push(case);
                 }
             }
         }
+        html_scenes.push(html_scene);
     }
     pb.finish_and_clear();
-    writeln!(md, "\nImages per case in `<scene>/<technique>/`: `visibility.png`, `error.png` (signed error, blue = too dark, red = too bright, full scale 0.5) and `shaded.png`; the reference in `<scene>/reference.png`.").ok();
+    writeln!(md, "\nImages per case in `<scene>/<technique>/`: `visibility.png`, `error.png` (signed error, blue = too dark, red = too bright, full scale 0.5), `shaded.png` and `flip.png` (FLIP's error map, magma); the reference in `<scene>/reference.png`. All of them, the table and a time-error plot per scene in `report.html`.").ok();
+    html::write_report(
+        &a.out.join("report.html"),
+        "Conformance report",
+        &format!(
+            "{} x {} pixels, reference {} samples per pixel, seed {}. Machine: {} ({} threads), {}. Images: visibility, signed error (blue too dark, red too bright, full scale 0.5), shaded, FLIP map. Click a column to sort.",
+            a.width, a.height, a.ref_samples, a.seed, m.cpu, m.threads, m.date
+        ),
+        &html_scenes,
+    )?;
     std::fs::write(a.out.join("report.md"), md).map_err(|e| e.to_string())?;
     write_json(
         &a.out.join("report.json"),

@@ -13,6 +13,8 @@ mod bench;
 mod budgets;
 mod common;
 mod conformance;
+mod flip;
+mod html;
 mod overrides;
 mod plot;
 mod render;

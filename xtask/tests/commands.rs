@@ -1,10 +1,12 @@
 //! The xtask commands a new user runs first, exercised through the built binary.
 
 mod common;
+mod gltf_files;
 
 use std::process::Command;
 
-use common::{gltf_of, square_at, temp_dir, xtask};
+use common::{temp_dir, xtask};
+use gltf_files::{gltf_of, square_at};
 
 /// `direct.exr` in `dir` is finite, non-negative and lit somewhere.
 fn assert_direct_image(dir: &std::path::Path) {
