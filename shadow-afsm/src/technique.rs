@@ -726,10 +726,13 @@ impl ShadowTechnique for Afsm {
     }
 
     fn capabilities(&self) -> Capabilities {
-        // Every light but meshes: the sample masks and the plane classification take one
-        // emitting plane or a sphere (section 3.1), not triangles facing many ways.
+        // Every light but meshes for soft shadows: the sample masks and the plane
+        // classification take one emitting plane or a sphere (section 3.1), not triangles
+        // facing many ways. Hard shadows use the light's centre only, so any light will do.
         let mut c = Capabilities::any_input(!self.hard, Processor::Gpu);
-        c.lights.retain(|k| *k != LightKind::Mesh);
+        if !self.hard {
+            c.lights.retain(|k| *k != LightKind::Mesh);
+        }
         c
     }
 

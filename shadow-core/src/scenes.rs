@@ -14,6 +14,7 @@
 //! | `textured-light` | an RGB image on a rectangle light |
 //! | `sphere-light` | an omni-directional sphere light inside a closed room |
 //! | `cornell-box` | an open five-wall room, the light recessed in a ceiling fixture, two spheres: receivers level with and behind the light, walls touching its fixture |
+//! | `spot-lamp` | a glTF file's `KHR_lights_punctual` spot light (a disk of radius 0.25 m) over a table on legs and a ball, loaded like a user's file |
 //! | `mesh-light` | a folded lamp (a mesh light, its two faces emitting from their undersides) over a box and a sphere: receivers that see one face, both or none |
 
 use std::sync::Arc;
@@ -31,7 +32,7 @@ use crate::procedural::{Mesh, cuboid, floor, grass, quad, uv_sphere};
 use crate::scene::{MeshDesc, SceneBuilder};
 
 /// Names of the built-in scenes, in a stable order.
-pub const BUILTIN_SCENES: [&str; 12] = [
+pub const BUILTIN_SCENES: [&str; 13] = [
     "quad-over-plane",
     "overlapping-occluders",
     "large-light-close",
@@ -43,11 +44,16 @@ pub const BUILTIN_SCENES: [&str; 12] = [
     "textured-light",
     "sphere-light",
     "cornell-box",
+    "spot-lamp",
     "mesh-light",
 ];
 
 const BUNNY_OBJ: &[u8] = include_bytes!("../assets/models/stanford-bunny.obj");
 const SPOT_OBJ: &[u8] = include_bytes!("../assets/models/spot.obj");
+/// Written by `scripts/make_spot_lamp_gltf.py`.
+const SPOT_LAMP_GLTF: &[u8] = include_bytes!("../assets/scenes/spot-lamp.gltf");
+/// The radius `spot-lamp` gives its file's spot light.
+pub const SPOT_LAMP_RADIUS: f32 = 0.25;
 
 /// Geometry of `quad-over-plane`, exposed for closed-form checks: light and occluder are
 /// squares centred on the Y axis, parallel to the floor at y = 0.
@@ -137,6 +143,12 @@ fn placed_obj(bytes: &[u8], size: f32, yaw: f32) -> Result<MeshDesc, BuiltinErro
 /// # Errors
 /// [`BuiltinError::Unknown`] listing the valid names.
 pub fn builtin(name: &str) -> Result<SceneSetup, BuiltinError> {
+    if name == "spot-lamp" {
+        let mut setup =
+            crate::load::load_gltf_slice(SPOT_LAMP_GLTF, None, name, &LoadLimits::default())?;
+        setup.set_punctual_radius(SPOT_LAMP_RADIUS)?;
+        return Ok(setup);
+    }
     use quad_over_plane as q;
     let down = |c: Vec3, side: f32, r: Radiance| {
         RectLight::new(

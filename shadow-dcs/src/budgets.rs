@@ -36,6 +36,7 @@ pub const DCS_64_DISCRETE: &[(&str, [f64; 5])] = &[
     ("semi-opaque", [0.0229, 0.0341, -0.0075, 0.196, 0.0150]),
     ("textured-light", [0.0047, 0.0047, -0.0001, 0.189, 0.0003]),
     ("cornell-box", [0.0077, 0.0128, -0.0006, 0.234, 0.0009]),
+    ("spot-lamp", [0.0101, 0.0353, -0.0008, 0.156, 0.0062]),
 ];
 
 /// `dcs-standard-silhouettes`.
@@ -57,6 +58,7 @@ pub const DCS_STANDARD: &[(&str, [f64; 5])] = &[
     ("textured-light", [0.0269, 0.0269, -0.0038, 0.653, 0.0123]),
     ("sphere-light", [0.0389, 0.0737, 0.0020, 1.000, 0.0114]),
     ("cornell-box", [0.0162, 0.0277, 0.0002, 0.359, 0.0048]),
+    ("spot-lamp", [0.0099, 0.0350, 0.0002, 0.375, 0.0016]),
 ];
 
 /// `dcs-64-interleaved` (tables with exact borders): semi-opaque only.

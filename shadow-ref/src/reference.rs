@@ -535,11 +535,14 @@ impl PreparedReference {
         &self.p.bvh
     }
 
-    /// The occlusion segment from view sample `s` to light point `y`: robust origin, unit
-    /// direction and length, or `None` when `y` is below the receiver's tangent plane.
-    ///
-    pub fn segment(&self, s: &ViewSample, y: Vec3) -> Option<(Vec3, Vec3, f32)> {
-        segment(&self.p, s, y)
+    /// The occlusion segment from view sample `s` to light sample `y`: robust origin, unit
+    /// direction and length, or `None` when `y` is below the receiver's tangent plane or, on a
+    /// light whose samples emit from one side (a mesh light), faces away from the receiver.
+    pub fn segment(&self, s: &ViewSample, y: &LightSample) -> Option<(Vec3, Vec3, f32)> {
+        if !self.p.faces(s, y) {
+            return None;
+        }
+        segment(&self.p, s, y.position)
     }
 
     /// Every occlusion segment the reference casts for `view`, in pixel and sample order:

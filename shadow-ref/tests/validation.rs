@@ -269,8 +269,8 @@ fn bvh_equals_brute_force_on_builtin_scenes() {
             let Some(s) = view.get(i) else { continue };
             sampler.unit_samples(s.pixel, &mut units);
             for (k, u) in units.iter().enumerate() {
-                let y = setup.lights[0].sample(*u).position;
-                let free = match r_prepared.segment(&s, y) {
+                let y = setup.lights[0].sample(*u);
+                let free = match r_prepared.segment(&s, &y) {
                     None => false,
                     Some((o, d, t)) => {
                         let ray = ShearedRay::new(o.into(), d.into());

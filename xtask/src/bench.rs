@@ -227,13 +227,8 @@ pub fn run(a: BenchArgs) -> Result<(), String> {
             .0
             .visibility;
         let shade = |v: &VisibilityImage| {
-            shaded_image(
-                setup.scene.as_ref(),
-                &view,
-                setup.lights[0].as_ref(),
-                v,
-            )
-            .map_err(|e| e.to_string())
+            shaded_image(setup.scene.as_ref(), &view, setup.lights[0].as_ref(), v)
+                .map_err(|e| e.to_string())
         };
         let truth_shaded = shade(&truth)?;
         let mut record = |technique: &str,

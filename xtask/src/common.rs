@@ -120,6 +120,7 @@ pub fn list_scenes() -> Result<(), String> {
         "RGB image on a rectangle light",
         "omni-directional sphere light inside a room",
         "open room, light recessed in a ceiling fixture, two spheres",
+        "glTF file's KHR_lights_punctual spot light over a table and a ball",
         "folded mesh light (two one-sided faces) over a box and a sphere",
     ];
     for (name, what) in BUILTIN_SCENES.iter().zip(what) {
