@@ -271,7 +271,7 @@ pub fn shaded_image(
             } else {
                 Vec3::splat(v.value(i)) * tint
             };
-            scene.albedo(s.triangle as usize) * vis * cos + Vec3::splat(0.02)
+            scene.albedo_at(s.triangle as usize, s.position) * vis * cos + Vec3::splat(0.02)
         }
         None => BACKGROUND,
     }))

@@ -40,6 +40,7 @@
 
 #![deny(missing_docs)]
 
+pub mod albedo;
 pub mod camera;
 pub mod direct;
 pub mod geometry;

@@ -5,6 +5,7 @@
 use glam::{Affine3A, DVec3, Vec3};
 use thiserror::Error;
 
+use crate::albedo::{AlbedoMaps, TexturedAlbedo};
 use crate::geometry::{Aabb, triangle_cross_f64, triangle_normal};
 use crate::topology::Topology;
 
@@ -106,6 +107,14 @@ pub enum SceneError {
     /// A transform is not finite or not invertible.
     #[error("mesh transform is not finite and invertible")]
     InvalidTransform,
+    /// Texture coordinates of an albedo texture are not finite.
+    #[error("texture coordinate {index} is {value:?}: not finite")]
+    InvalidTexcoord {
+        /// Vertex index in the mesh.
+        index: usize,
+        /// The offending value.
+        value: [f32; 2],
+    },
 }
 
 /// A scene of triangles as every technique sees it.
@@ -130,6 +139,12 @@ pub trait Scene: Send + Sync {
     /// Per-triangle diffuse albedo, used only for shaded images (default 0.8 grey).
     fn albedo(&self, _triangle: usize) -> Vec3 {
         Vec3::splat(0.8)
+    }
+    /// The diffuse albedo at point `p` of triangle `triangle` (a view sample's position), for
+    /// shaded images and direct light: a base-colour texture where the triangle has one,
+    /// else [`Scene::albedo`].
+    fn albedo_at(&self, triangle: usize, _p: Vec3) -> Vec3 {
+        self.albedo(triangle)
     }
     /// Number of triangles.
     fn triangle_count(&self) -> usize {
@@ -176,6 +191,8 @@ pub struct TriangleScene {
     opacities: Vec<f32>,
     albedos: Vec<Vec3>,
     normals: Option<Vec<Vec3>>,
+    /// Base-colour textures, when any mesh has one.
+    albedo_maps: Option<AlbedoMaps>,
     topology: Topology,
     bounds: Aabb,
     dropped_degenerate: usize,
@@ -211,9 +228,21 @@ impl TriangleScene {
             normals: self.normals.clone(),
             opacity: PerTriangle::Each(self.opacities.clone()),
             albedo: PerTriangle::Each(self.albedos.clone()),
+            albedo_texture: None,
             transform: world_from_scene,
         })?;
-        b.build()
+        // Degenerate triangles are rejected, so the triangles keep their order and the
+        // textures theirs (a mirroring transform reverses every winding, corners and
+        // coordinates alike).
+        let mut scene = b.build()?;
+        scene.albedo_maps = self.albedo_maps.as_ref().map(|m| {
+            if world_from_scene.matrix3.determinant() < 0.0 {
+                m.mirrored()
+            } else {
+                m.clone()
+            }
+        });
+        Ok(scene)
     }
 }
 
@@ -238,6 +267,12 @@ impl Scene for TriangleScene {
     }
     fn albedo(&self, triangle: usize) -> Vec3 {
         self.albedos[triangle]
+    }
+    fn albedo_at(&self, triangle: usize, p: Vec3) -> Vec3 {
+        self.albedo_maps
+            .as_ref()
+            .and_then(|m| m.at(triangle, self.triangle(triangle), p))
+            .unwrap_or(self.albedos[triangle])
     }
     fn has_semi_opaque(&self) -> bool {
         self.semi_opaque
@@ -266,6 +301,9 @@ pub struct MeshDesc {
     pub opacity: PerTriangle<f32>,
     /// Diffuse albedo in [0, 1].
     pub albedo: PerTriangle<Vec3>,
+    /// A base-colour texture with per-vertex coordinates; it replaces `albedo` in shaded and
+    /// direct output ([`Scene::albedo_at`]).
+    pub albedo_texture: Option<TexturedAlbedo>,
     /// World from mesh transform.
     pub transform: Affine3A,
 }
@@ -279,6 +317,7 @@ impl MeshDesc {
             normals: None,
             opacity: PerTriangle::All(1.0),
             albedo: PerTriangle::All(Vec3::splat(0.8)),
+            albedo_texture: None,
             transform: Affine3A::IDENTITY,
         }
     }
@@ -317,6 +356,7 @@ pub struct SceneBuilder {
     albedos: Vec<Vec3>,
     normals: Vec<Option<Vec3>>,
     any_normals: bool,
+    albedo_maps: Option<AlbedoMaps>,
     policy: DegeneratePolicy,
 }
 
@@ -374,6 +414,15 @@ impl SceneBuilder {
         if let Some(n) = &mesh.normals {
             check_len("normals", n.len(), nv)?;
         }
+        if let Some(t) = &mesh.albedo_texture {
+            check_len("texture coordinates", t.texcoords.len(), nv)?;
+            if let Some(i) = t.texcoords.iter().position(|c| !c.is_finite()) {
+                return Err(SceneError::InvalidTexcoord {
+                    index: i,
+                    value: t.texcoords[i].to_array(),
+                });
+            }
+        }
         let base = self.positions.len();
         if base + nv > u32::MAX as usize {
             return Err(SceneError::TooLarge {
@@ -421,6 +470,25 @@ impl SceneBuilder {
                 .push(if flip { [a, c, b] } else { [a, b, c] });
         }
         let t0 = self.triangles.len() - nt;
+        match (&mesh.albedo_texture, &mut self.albedo_maps) {
+            (Some(t), maps) => {
+                let uv = |v: u32| t.texcoords[v as usize];
+                maps.get_or_insert_with(|| AlbedoMaps::untextured(t0))
+                    .push_textured(
+                        &t.texture,
+                        mesh.triangles.iter().map(|&[a, b, c]| {
+                            // In the winding the triangle was stored with.
+                            if flip {
+                                [uv(a), uv(c), uv(b)]
+                            } else {
+                                [uv(a), uv(b), uv(c)]
+                            }
+                        }),
+                    );
+            }
+            (None, Some(maps)) => maps.push_untextured(nt),
+            (None, None) => {}
+        }
         match mesh.opacity {
             PerTriangle::All(o) => self.opacities.extend(std::iter::repeat_n(o, nt)),
             PerTriangle::Each(v) => self.opacities.extend(v),
@@ -447,6 +515,7 @@ impl SceneBuilder {
             albedos,
             normals,
             any_normals,
+            albedo_maps,
             policy,
         } = self;
         for (i, p) in positions.iter().enumerate() {
@@ -530,12 +599,14 @@ impl SceneBuilder {
         let topology = Topology::build(&triangles);
         let bounds = Aabb::from_points(&positions);
         let semi_opaque = opacities.iter().any(|&o| o < 1.0);
+        let albedo_maps = albedo_maps.map(|m| m.kept(&keep));
         Ok(TriangleScene {
             positions,
             triangles,
             opacities,
             albedos,
             normals,
+            albedo_maps,
             topology,
             bounds,
             dropped_degenerate: dropped,

@@ -531,7 +531,7 @@ fn shade_from_per_sample(
                 sampler.unit_samples(s.pixel, &mut units);
                 samples.clear();
                 light.sample_into(&units, &mut samples);
-                let albedo = scene.albedo(s.triangle as usize);
+                let albedo = scene.albedo_at(s.triangle as usize, s.position);
                 let v = |k: usize| if per.visible(i, k as u32) { 1.0 } else { 0.0 };
                 *px = shade(&s, albedo, &samples, &v);
             }

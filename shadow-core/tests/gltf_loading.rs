@@ -30,7 +30,7 @@ fn test_document() -> Value {
     let grey =
         w.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.6, 0.7, 1.0]}}));
     let glass = w.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 0.4]}, "alphaMode": "BLEND"}));
-    let masked = w.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 0.4]}, "alphaMode": "MASK"}));
+    let masked = w.material(json!({"pbrMetallicRoughness": {"baseColorFactor": [1.0, 1.0, 1.0, 0.6]}, "alphaMode": "MASK"}));
     let lamp = w.material(json!({"emissiveFactor": [1.0, 0.5, 0.25], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4.0}}}));
     let image = w.png_image(2, 1, &[[255, 0, 0], [0, 0, 255]]);
     let textured =
@@ -128,12 +128,26 @@ fn lights_camera_and_opacities_load_as_written() {
     // The file's near plane (issue 51, item 10: it was ignored for a fixed 1e-4).
     assert_eq!(cam.near(), 0.01);
     assert_eq!(setup.aspect, Some(1.5));
-    // Opacities: floor opaque, BLEND glass 0.4, MASK ignores alpha.
+    // Opacities: floor opaque, BLEND glass 0.4, MASK at alpha 0.6 (above its cutoff) opaque.
     let s = &setup.scene;
     assert_eq!(s.triangle_count(), 6);
     assert_eq!(s.opacities(), &[1.0, 1.0, 0.4, 0.4, 1.0, 1.0]);
     assert!((s.albedo(0) - Vec3::new(0.5, 0.6, 0.7)).length() < 1e-6);
     assert!(s.has_semi_opaque());
+    // Below its cutoff a masked mesh is fully transparent: not loaded, and a note says so.
+    let mut doc = test_document();
+    doc["materials"][2]["pbrMetallicRoughness"]["baseColorFactor"] = json!([1.0, 1.0, 1.0, 0.4]);
+    doc["materials"][2]["name"] = json!("leaf");
+    let setup = load(&doc).unwrap();
+    assert_eq!(setup.scene.triangle_count(), 4);
+    assert!(
+        setup
+            .warnings
+            .iter()
+            .any(|w| w.contains("masked out") && w.contains("leaf") && w.contains("0.5")),
+        "{:?}",
+        setup.warnings
+    );
 }
 
 #[test]

@@ -438,7 +438,7 @@ impl PreparedAdaptive {
             }
         }
         if wants.direct {
-            let albedo = p.scene.albedo(s.triangle as usize);
+            let albedo = p.scene.albedo_at(s.triangle as usize, s.position);
             let point = light.area() == 0.0;
             for (y, &v) in buf.samples.iter().zip(vis) {
                 if v > 0.0 {

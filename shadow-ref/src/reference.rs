@@ -583,7 +583,7 @@ impl PreparedReference {
                 let rb = c.receiver_beam(p, &s, samples.len(), &mut scratch);
                 c.sample_visibility(p, &s, &rb, &samples, &mut scratch);
                 let vis = &scratch.vis;
-                let albedo = p.scene.albedo(s.triangle as usize);
+                let albedo = p.scene.albedo_at(s.triangle as usize, s.position);
                 let light: &dyn AreaLight = if c.source == SampleSource::Hard {
                     &HardLight(p.light.center())
                 } else {

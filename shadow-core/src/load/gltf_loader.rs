@@ -1,8 +1,10 @@
 //! glTF 2.0 loading through the `gltf` crate, with every buffer, accessor and image bound-checked
 //! by hand before reading (DESIGN section 8: Y up, metres; emissive meshes are area lights,
 //! `KHR_materials_emissive_strength` honoured; base-colour alpha of `BLEND` materials is occluder
-//! opacity; the first perspective camera is the view).
+//! opacity; base-colour textures are the albedo of shaded and direct output
+//! ([`crate::albedo`]); the first perspective camera is the view).
 
+use std::collections::HashMap;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -14,8 +16,9 @@ use gltf::mesh::Mode;
 use gltf::{Document, Semantic};
 
 use super::emissive::{EmissiveTexture, light_from_emissive_mesh};
-use super::texture::{EMISSIVE_TEXTURE_SIDE, box_filtered};
+use super::texture::{EMISSIVE_TEXTURE_SIDE, LoadedImage, load_image};
 use super::{LoadError, LoadLimits, SceneSetup, read_limited};
+use crate::albedo::{AlbedoTexture, TexturedAlbedo};
 use crate::camera::Camera;
 use crate::light::Light;
 use crate::scene::{DegeneratePolicy, MeshDesc, PerTriangle, SceneBuilder};
@@ -124,7 +127,9 @@ pub fn load_gltf_slice(
             ));
         }
     }
-    let mut textured_albedo = Vec::new();
+    // Base-colour textures by (image, factor): meshes sharing a material share one texture.
+    let mut albedo_textures: HashMap<(usize, [u32; 3]), Arc<AlbedoTexture>> = HashMap::new();
+    let mut untextured_albedo: Vec<String> = Vec::new();
     let mut punctual = Vec::new();
     let mut vertices_total = 0u64;
     let mut occluders = 0usize;
@@ -249,7 +254,7 @@ pub fn load_gltf_slice(
                                 height,
                                 texels,
                                 decoded,
-                            } = load_image(&doc, &buffers, info.texture().source(), base, limits)?;
+                            } = load_image(&buffers, info.texture().source(), base, limits)?;
                             if decoded != (width, height) {
                                 warnings.push(format!(
                                     "mesh '{mesh_name}': its {}x{} emissive texture is \
@@ -283,18 +288,93 @@ pub fn load_gltf_slice(
                 }
                 let pbr = material.pbr_metallic_roughness();
                 let base_color = pbr.base_color_factor();
-                if pbr.base_color_texture().is_some() {
-                    let name = material.name().map_or_else(
+                let factor = Vec3::new(base_color[0], base_color[1], base_color[2])
+                    .clamp(Vec3::ZERO, Vec3::ONE);
+                let albedo_texture = match pbr.base_color_texture() {
+                    None => None,
+                    Some(info) => match prim.get(&Semantic::TexCoords(info.tex_coord())) {
+                        None => {
+                            let name = format!(
+                                "{} (mesh '{mesh_name}')",
+                                material.name().unwrap_or("unnamed material")
+                            );
+                            if !untextured_albedo.contains(&name) {
+                                untextured_albedo.push(name);
+                            }
+                            None
+                        }
+                        Some(acc) => {
+                            let image = info.texture().source();
+                            let key = (image.index(), factor.to_array().map(f32::to_bits));
+                            let texture = match albedo_textures.get(&key) {
+                                Some(t) => Arc::clone(t),
+                                None => {
+                                    let img = load_image(&buffers, image, base, limits)?;
+                                    if img.decoded != (img.width, img.height) {
+                                        warnings.push(format!(
+                                            "mesh '{mesh_name}': its {}x{} base-colour texture \
+                                             is box-filtered to {}x{}",
+                                            img.decoded.0, img.decoded.1, img.width, img.height
+                                        ));
+                                    }
+                                    let t = Arc::new(
+                                        AlbedoTexture::new(
+                                            img.width, img.height, img.texels, factor,
+                                        )
+                                        .map_err(LoadError::Texture)?,
+                                    );
+                                    albedo_textures.insert(key, Arc::clone(&t));
+                                    t
+                                }
+                            };
+                            Some(TexturedAlbedo {
+                                texture,
+                                texcoords: read_vec2(&buffers, &acc, limits)?,
+                            })
+                        }
+                    },
+                };
+                let material_name = || {
+                    material.name().map_or_else(
                         || format!("#{}", material.index().unwrap_or(0)),
                         String::from,
-                    );
-                    if !textured_albedo.contains(&name) {
-                        textured_albedo.push(name);
-                    }
-                }
+                    )
+                };
+                let alpha = base_color[3].clamp(0.0, 1.0);
+                let textured_alpha = pbr.base_color_texture().is_some();
                 let opacity = match material.alpha_mode() {
-                    gltf::material::AlphaMode::Blend => base_color[3].clamp(0.0, 1.0),
-                    _ => 1.0,
+                    gltf::material::AlphaMode::Blend => {
+                        if textured_alpha {
+                            warnings.push(format!(
+                                "mesh '{mesh_name}': the alpha of material {}'s base-colour \
+                                 texture is not read (its opacity is the factor's, {alpha})",
+                                material_name()
+                            ));
+                        }
+                        alpha
+                    }
+                    gltf::material::AlphaMode::Mask => {
+                        // glTF: fully opaque at or above the cutoff, fully transparent below.
+                        let cutoff = material.alpha_cutoff().unwrap_or(0.5);
+                        if textured_alpha {
+                            warnings.push(format!(
+                                "mesh '{mesh_name}': the alpha mask of material {}'s \
+                                 base-colour texture is not read (the mask is the factor's \
+                                 alpha {alpha} against the cutoff {cutoff})",
+                                material_name()
+                            ));
+                        }
+                        if alpha < cutoff {
+                            warnings.push(format!(
+                                "mesh '{mesh_name}' is masked out (material {}: alpha {alpha} \
+                                 below its cutoff {cutoff}) and casts no shadow",
+                                material_name()
+                            ));
+                            continue;
+                        }
+                        1.0
+                    }
+                    gltf::material::AlphaMode::Opaque => 1.0,
                 };
                 let normals = match prim.get(&Semantic::Normals) {
                     Some(a) => Some(read_vec3(&buffers, &a, limits)?),
@@ -303,10 +383,8 @@ pub fn load_gltf_slice(
                 let mut desc = MeshDesc::new(positions, triangles);
                 desc.normals = normals;
                 desc.opacity = PerTriangle::All(opacity);
-                desc.albedo = PerTriangle::All(
-                    Vec3::new(base_color[0], base_color[1], base_color[2])
-                        .clamp(Vec3::ZERO, Vec3::ONE),
-                );
+                desc.albedo = PerTriangle::All(factor);
+                desc.albedo_texture = albedo_texture;
                 desc.transform = Affine3A::from_mat4(world);
                 builder.push_mesh(desc)?;
                 occluders += 1;
@@ -322,10 +400,11 @@ pub fn load_gltf_slice(
             reason: "the file has no non-emissive geometry".into(),
         });
     }
-    if !textured_albedo.is_empty() {
+    if !untextured_albedo.is_empty() {
         warnings.push(format!(
-            "base-colour textures are not read (albedo is the material's factor): {}",
-            textured_albedo.join(", ")
+            "base-colour textures without texture coordinates are not read (albedo is the \
+             material's factor): {}",
+            untextured_albedo.join(", ")
         ));
     }
     let scene = builder.build()?;
@@ -379,7 +458,7 @@ fn assemble(mode: Mode, idx: &[u32], mesh: &str) -> Result<Vec<[u32; 3]>, LoadEr
     })
 }
 
-fn decode_data_uri(uri: &str, limit: u64) -> Result<Option<Vec<u8>>, LoadError> {
+pub(super) fn decode_data_uri(uri: &str, limit: u64) -> Result<Option<Vec<u8>>, LoadError> {
     let Some(rest) = uri.strip_prefix("data:") else {
         return Ok(None);
     };
@@ -403,7 +482,7 @@ fn decode_data_uri(uri: &str, limit: u64) -> Result<Option<Vec<u8>>, LoadError> 
 /// The glTF extensions whose data the loader reads.
 const HONOURED_EXTENSIONS: &[&str] = &["KHR_materials_emissive_strength", "KHR_lights_punctual"];
 
-fn resolve(base: Option<&Path>, uri: &str) -> Result<PathBuf, LoadError> {
+pub(super) fn resolve(base: Option<&Path>, uri: &str) -> Result<PathBuf, LoadError> {
     let base = base.ok_or_else(|| {
         LoadError::Missing(format!("external URI `{uri}` with no base directory"))
     })?;
@@ -681,97 +760,4 @@ fn read_indices(
             _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
         })
         .collect())
-}
-
-fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-fn load_image(
-    doc: &Document,
-    buffers: &[Vec<u8>],
-    image: gltf::Image,
-    base: Option<&Path>,
-    limits: &LoadLimits,
-) -> Result<LoadedImage, LoadError> {
-    let _ = doc;
-    let bytes: Vec<u8> = match image.source() {
-        gltf::image::Source::View { view, .. } => {
-            let buf = buffers
-                .get(view.buffer().index())
-                .ok_or_else(|| LoadError::Missing(format!("buffer {}", view.buffer().index())))?;
-            let (o, l) = (view.offset(), view.length());
-            o.checked_add(l)
-                .and_then(|end| buf.get(o..end))
-                .ok_or_else(|| {
-                    LoadError::Texture(format!("image view {} exceeds its buffer", view.index()))
-                })?
-                .to_vec()
-        }
-        gltf::image::Source::Uri { uri, .. } => {
-            match decode_data_uri(uri, limits.max_buffer_bytes)? {
-                Some(d) => d,
-                None => read_limited(&resolve(base, uri)?, limits.max_buffer_bytes)?,
-            }
-        }
-    };
-    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| LoadError::Texture(e.to_string()))?;
-    let mut lim = image::Limits::default();
-    let side = (limits.max_image_pixels as f64).sqrt().ceil() as u32;
-    lim.max_image_width = Some(side.max(1) * 4);
-    lim.max_image_height = Some(side.max(1) * 4);
-    lim.max_alloc = Some(limits.max_image_pixels * 16);
-    reader.limits(lim);
-    let img = reader
-        .decode()
-        .map_err(|e| LoadError::Texture(e.to_string()))?;
-    let (w, h) = (img.width(), img.height());
-    if w as u64 * h as u64 > limits.max_image_pixels {
-        return Err(LoadError::Limit {
-            what: "the texture's pixel count".into(),
-            size: w as u64 * h as u64,
-            limit: limits.max_image_pixels,
-        });
-    }
-    let linear = !matches!(
-        img,
-        image::DynamicImage::ImageRgb8(_)
-            | image::DynamicImage::ImageRgba8(_)
-            | image::DynamicImage::ImageLuma8(_)
-            | image::DynamicImage::ImageLumaA8(_)
-            | image::DynamicImage::ImageRgb16(_)
-            | image::DynamicImage::ImageRgba16(_)
-    );
-    let to_linear = |c: Vec3| {
-        if linear {
-            c
-        } else {
-            Vec3::new(
-                srgb_to_linear(c.x),
-                srgb_to_linear(c.y),
-                srgb_to_linear(c.z),
-            )
-        }
-    };
-    let (width, height, texels) = box_filtered(&img, EMISSIVE_TEXTURE_SIDE, to_linear);
-    Ok(LoadedImage {
-        width,
-        height,
-        texels,
-        decoded: (w, h),
-    })
-}
-
-/// An emissive texture as loaded: linear RGB texels, and the size the file had.
-struct LoadedImage {
-    width: u32,
-    height: u32,
-    texels: Vec<Vec3>,
-    decoded: (u32, u32),
 }

@@ -225,7 +225,7 @@ impl Dcs {
                     } else {
                         &scratch.samples
                     };
-                    let albedo = p.scene.albedo(s.triangle as usize);
+                    let albedo = p.scene.albedo_at(s.triangle as usize, s.position);
                     let vis = &scratch.vis;
                     out.push((i, pixel_direct(s, albedo, light, samples, |k| vis[k])));
                 },
