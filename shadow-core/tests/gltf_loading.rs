@@ -378,11 +378,16 @@ fn ignored_material_data_is_named_in_a_note() {
         "KHR_materials_transmission"
     ]);
     doc["materials"][0]["name"] = json!("grey paint");
+    doc["materials"][1]["name"] = json!("window");
+    doc["materials"][1]["extensions"] =
+        json!({"KHR_materials_transmission": {"transmissionFactor": 1.0}});
     doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = json!({"index": 0});
     let setup = load(&doc).unwrap();
     let all = setup.warnings.join("\n");
     assert!(all.contains("KHR_materials_transmission"), "{all}");
     assert!(all.contains("opaque shadows"), "{all}");
+    // The note names the material that uses the extension.
+    assert!(all.contains("materials: window"), "{all}");
     assert!(
         !all.contains("extension KHR_materials_emissive_strength"),
         "{all}"

@@ -115,14 +115,28 @@ pub fn load_gltf_slice(
     // data dropped is never dropped without a word (glass that casts an opaque shadow, say).
     for ext in doc.extensions_used() {
         if !HONOURED_EXTENSIONS.contains(&ext) {
+            // The materials that use it, by name.
+            let users: Vec<String> = doc
+                .materials()
+                .filter(|m| m.extension_value(ext).is_some())
+                .map(|m| {
+                    m.name()
+                        .map_or_else(|| format!("#{}", m.index().unwrap_or(0)), String::from)
+                })
+                .collect();
             warnings.push(format!(
-                "extension {ext} is not read: what it adds is ignored{}",
+                "extension {ext} is not read: what it adds is ignored{}{}",
                 match ext {
                     "KHR_materials_transmission" | "KHR_materials_volume" => {
                         " (transmissive materials cast opaque shadows)"
                     }
                     "KHR_materials_unlit" => " (unlit materials are shaded and cast shadows)",
                     _ => "",
+                },
+                if users.is_empty() {
+                    String::new()
+                } else {
+                    format!("; materials: {}", users.join(", "))
                 }
             ));
         }
