@@ -6,33 +6,37 @@
 //! rays, then turned into the visibility coefficient (eq. 1), its textured-light form (eq. 2)
 //! and the direct illumination (eq. 6).
 //!
+//! The layout follows the paper. [`stages`] holds its stages, each citing its section:
 //! * [`edges`]: scene edges, weights and accurate or standard silhouette detection (section 4.1);
-//! * `constant`: the integration constant by the shadow-volume step (section 4.1);
-//! * `wedges`: each penumbra wedge's bounding planes and weight (section 4.2);
-//! * `bins` (internal): the box hierarchy over the view samples that finds each wedge's view
-//!   samples (blocks, squares, tiles, then the tile's view samples);
-//! * `coverage`: the light samples an edge covers, exactly (Algorithm 1, Fig. 2), in 3D, and
-//!   the exact test that an edge seen from a pixel covers part of a planar light at all;
-//! * `planar` (internal): the same test in a planar light's plane, set up per pair from per-edge
-//!   vectors in single precision;
-//! * `angular` (internal): a per-pixel angular index of the light samples that finds each
-//!   edge's candidate samples with two lookups (section 7.3's sector table, per pixel);
-//! * `centred` (internal): the per-(pixel, edge) tests in light-centred single precision, with
-//!   exact fallbacks;
-//! * `lanes` (internal): tiles of 4 x 4 view samples in structure-of-arrays form, on which the
-//!   wedge scan tests a wedge's planes and weights for the whole tile at once;
-//! * [`discrete`]: the sector and line tables of section 7.3 (Fig. 8);
-//! * `counters`: packed counters with overflow detection (sections 4.3, 4.4, 5.3), the
+//! * `stages::constant`: the integration constant by the shadow-volume step (section 4.1);
+//! * `stages::wedges`: each penumbra wedge's exact bounding planes and weight (section 4.2);
+//! * `stages::coverage`: the light samples an edge covers, exactly (Algorithm 1, Fig. 2), in 3D,
+//!   and the exact test that an edge seen from a pixel covers part of a planar light at all;
+//! * `stages::counters`: packed counters with overflow detection (sections 4.3, 4.4, 5.3), the
 //!   paper's lanes and a bit-sliced form;
-//! * [`technique`]: the [`Dcs`] technique; [`presets`] registers its configurations.
-//! * [`paper`]: the same algorithm as the paper writes it (Algorithm 1 in f64 and plain
-//!   integers, no search structure, no tables), the oracle the technique is tested against
-//!   sample by sample (`tests/paper.rs`).
+//! * [`discrete`]: the sector and line tables of section 7.3 (Fig. 8);
+//! * `stages::light_shape`: the light as the stages see it (outline or sphere, exact form).
 //!
-//! The paper's stages are `edges`, `constant`, `wedges`, `coverage`, `counters` and
-//! `discrete`; the acceleration that the technique adds on top is `bins`, `lanes`, `centred`,
-//! `planar`, `angular` and `shared_sets`. (`wedges` still builds the single-precision plane
-//! forms of `centred` beside its exact planes; separating the two folders is open work.)
+//! `accel` (internal) holds what the technique adds on top, and may import the stages, never
+//! the reverse:
+//! * `accel::centred_wedges`: the wedges' planes and weights around the light centre in single
+//!   precision, as the wedge scan tests them;
+//! * `accel::bins`: the box hierarchy over the view samples that finds each wedge's view
+//!   samples (blocks, squares, tiles, then the tile's view samples);
+//! * `accel::planar`: the coverage test in a planar light's plane, set up per pair from per-edge
+//!   vectors in single precision;
+//! * `accel::angular`: a per-pixel angular index of the light samples that finds each edge's
+//!   candidate samples with two lookups (section 7.3's sector table, per pixel);
+//! * `accel::centred`: the per-(pixel, edge) tests in light-centred single precision, with
+//!   exact fallbacks;
+//! * `accel::lanes`: tiles of 4 x 4 view samples in structure-of-arrays form, on which the
+//!   wedge scan tests a wedge's planes and weights for the whole tile at once;
+//! * `accel::shared_sets`: light-sample sets shared between pixels (interleaved sampling).
+//!
+//! [`technique`] is the [`Dcs`] technique that runs both; [`presets`] registers its
+//! configurations; [`paper`] is the same algorithm as the paper writes it (Algorithm 1 in f64
+//! and plain integers, no search structure, no tables), the oracle the technique is tested
+//! against sample by sample (`tests/paper.rs`).
 //!
 //! # When DCS pays
 //!
@@ -67,25 +71,14 @@
 
 #![deny(missing_docs)]
 
-mod angular;
-mod bins;
+mod accel;
 mod budgets;
-mod centred;
-mod constant;
-mod counters;
-mod coverage;
-pub mod discrete;
-pub mod edges;
-mod lanes;
-mod light_shape;
 pub mod paper;
-mod planar;
 mod presets;
-mod shared_sets;
+pub mod stages;
 pub mod technique;
-mod wedges;
 
-pub use discrete::CoveredSamples;
-pub use edges::Silhouettes;
 pub use presets::presets;
+pub use stages::discrete::{self, CoveredSamples};
+pub use stages::edges::{self, Silhouettes};
 pub use technique::{Dcs, PerSampleOutput};

@@ -28,10 +28,10 @@ use shadow_core::offset::RayOffset;
 use shadow_core::prelude::*;
 use shadow_core::technique::UnsupportedReason;
 
-use crate::constant::{eye_constant, integration_constants};
-use crate::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
-use crate::light_shape::LightShape;
-use crate::wedges::{Plane, wedge_planes};
+use crate::stages::constant::{eye_constant, integration_constants};
+use crate::stages::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
+use crate::stages::light_shape::LightShape;
+use crate::stages::wedges::{Plane, wedge_planes};
 
 /// The depth complexity of a sample below the receiver's tangent plane (occluded without a
 /// count).
@@ -46,7 +46,7 @@ pub struct PaperDepthComplexity {
     /// Light samples per pixel.
     pub samples: u32,
     /// Per pixel and sample (pixel-major): the depth complexity in the technique's units (one
-    /// per opaque surface, [`crate::edges::OPACITY_UNITS`] per surface with semi-opaque
+    /// per opaque surface, [`crate::stages::edges::OPACITY_UNITS`] per surface with semi-opaque
     /// occluders), [`BELOW_HORIZON`] for a sample below the tangent plane, 0 on background.
     pub depth: Vec<i64>,
     /// Per pixel and sample: a numerical tie decided the count.

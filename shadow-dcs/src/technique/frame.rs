@@ -136,7 +136,7 @@ impl Dcs {
     }
 
     /// Runs `work` on every square of the view in parallel, with the wedges its box keeps (the
-    /// box hierarchy of [`crate::bins`]: blocks, then their squares). Returns each square's
+    /// box hierarchy of [`crate::accel::bins`]: blocks, then their squares). Returns each square's
     /// result and the number of (block, wedge) pairs kept.
     pub(super) fn squares<T: Send>(
         &self,
@@ -146,7 +146,7 @@ impl Dcs {
     ) -> (Vec<(Rect, T)>, u64) {
         let view = f.view;
         let input = Self::scan_input(p, f);
-        let blocks = crate::bins::blocks(view.width(), view.height());
+        let blocks = crate::accel::bins::blocks(view.width(), view.height());
         let levels = BlockWedges::new(&input, &blocks);
         // Every block's square lists first, then all squares of the view as one parallel
         // loop: a block boundary is no barrier, so a thread that runs out of work steals any

@@ -2,7 +2,7 @@
 //!
 //! Per frame (Algorithm 2 for one light):
 //! 1. silhouette edges of the scene for the light (prepared once per scene and light,
-//!    [`crate::edges`], section 4.1);
+//!    [`crate::stages::edges`], section 4.1);
 //! 2. the integration constant `D(p, c)` of every view sample by the shadow-volume step
 //!    (`constant`, section 4.1), and the counter width from its maximum (section 5.3);
 //! 3. square by square (16 x 16 pixels), the wedges' view samples and each one's weight
@@ -46,21 +46,22 @@ use shadow_core::technique::{Capabilities, Processor, SceneRef};
 use shadow_core::view_samples::ViewSample;
 use shadow_core::visibility::{PerSampleVisibility, PixelClass};
 
-use crate::angular::{BATCH, QuadRanges};
-use crate::bins::{
+use crate::accel::angular::{BATCH, QuadRanges};
+use crate::accel::bins::{
     BlockWedges, Rect, SQUARE, ScanCounts, ScanInput, ScanWedge, SquarePairs, SquareScratch,
     WedgeLanes, square_pairs,
 };
-use crate::centred::CentredEdge;
-use crate::constant::{eye_constant, integration_constants};
-use crate::counters::{self, BitSliced, Packed, WIDTHS, width_for};
-use crate::coverage::{EdgeTest, RelativePolygon, RelativeSamples};
-use crate::discrete::{CoveredSamples, DiscreteTables, LineMasks};
-use crate::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
-use crate::light_shape::LightShape;
-use crate::planar::{PlanarEdge, PlanarTest, RectMap};
-use crate::shared_sets::{SampleSet, SetForm, SharedSets};
-use crate::wedges::{FOLD_SLACK, Pair, wedges};
+use crate::accel::centred::CentredEdge;
+use crate::accel::centred_wedges::wedges;
+use crate::accel::planar::{PlanarEdge, PlanarTest, RectMap};
+use crate::accel::shared_sets::{SampleSet, SetForm, SharedSets};
+use crate::stages::constant::{eye_constant, integration_constants};
+use crate::stages::counters::{self, BitSliced, Packed, WIDTHS, width_for};
+use crate::stages::coverage::{EdgeTest, RelativePolygon, RelativeSamples};
+use crate::stages::discrete::{CoveredSamples, DiscreteTables, LineMasks};
+use crate::stages::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
+use crate::stages::light_shape::LightShape;
+use crate::stages::wedges::{FOLD_SLACK, Pair};
 
 mod frame;
 mod pixel;
@@ -103,7 +104,7 @@ struct Prepared {
     rect: Option<RectMap>,
 }
 
-/// A planar light's frame, for the light-plane test ([`crate::planar`]).
+/// A planar light's frame, for the light-plane test ([`crate::accel::planar`]).
 struct PlanarLight {
     u: Vec3,
     v: Vec3,
@@ -120,7 +121,7 @@ pub struct Dcs {
     covered: CoveredSamples,
     output: PerSampleOutput,
     forced_bits: Option<u32>,
-    /// Whether pixels of one shared sample set share its set-up ([`crate::shared_sets`]);
+    /// Whether pixels of one shared sample set share its set-up ([`crate::accel::shared_sets`]);
     /// off only in tests, which check the shared set-up against each pixel's own.
     share_sets: bool,
 }
@@ -154,7 +155,7 @@ impl std::fmt::Debug for Dcs {
 /// Per-frame data shared by every pixel.
 struct Frame<'a> {
     origins: Vec<Vec3>,
-    /// `origins` relative to the light centre ([`crate::centred`]).
+    /// `origins` relative to the light centre ([`crate::accel::centred`]).
     centred: Vec<Vec3>,
     horizon: Vec<Horizon>,
     active: Vec<bool>,
@@ -536,7 +537,7 @@ mod tests {
     #[test]
     fn squares_scatter_onto_their_pixels() {
         let (w, h) = (150u32, 37u32);
-        let squares: Vec<Rect> = crate::bins::blocks(w, h)
+        let squares: Vec<Rect> = crate::accel::bins::blocks(w, h)
             .into_iter()
             .flat_map(|(_, s)| s)
             .collect();

@@ -350,7 +350,7 @@ impl Dcs {
     /// A per-sample pixel's samples: positions, the horizon mask, the samples relative to the
     /// view sample (in the light plane with `planar`), the angular index (`indexed`), and empty
     /// update lists. What depends on the samples alone comes from the pixel's shared set when
-    /// it has one (correlated and interleaved sampling, [`crate::shared_sets`]), built once.
+    /// it has one (correlated and interleaved sampling, [`crate::accel::shared_sets`]), built once.
     #[expect(
         clippy::too_many_arguments,
         reason = "the per-pixel pass hands its prepared data, frame, pixel, scratch and counters down the hot path"

@@ -26,7 +26,7 @@ use shadow_core::scene::Scene;
 
 use shadow_core::geometry::ray_hits_triangle;
 
-use crate::edges::SceneEdge;
+use crate::stages::edges::SceneEdge;
 
 /// Far vertices lie at this many times the largest eye or sample distance from `c`: a quad's
 /// far edge is a chord, and it stays beyond every view sample unless the edge subtends more
@@ -277,8 +277,8 @@ fn near_zero(view: &RasterView, scale: f64) -> RasterView {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::edges::{Silhouettes, scene_edges, silhouettes};
-    use crate::light_shape::LightShape;
+    use crate::stages::edges::{Silhouettes, scene_edges, silhouettes};
+    use crate::stages::light_shape::LightShape;
     use shadow_core::light::{Radiance, RectLight};
     use shadow_core::prelude::*;
     use shadow_core::procedural;

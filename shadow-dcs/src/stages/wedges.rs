@@ -17,16 +17,15 @@
 //! view samples inside each wedge are found by the box hierarchy of `bins` (the spatial
 //! structure that plays the part of the GPU's rasterization of wedges); each gets the exact
 //! weight `k_e(p)` (`SceneEdge::sweep_weight`, or its single-precision form with an error bound,
-//! `centred::FastWeight`), and only view samples with a non-zero weight are kept. The
+//! in the acceleration's `centred_wedges`), and only view samples with a non-zero weight are
+//! kept. The
 //! shadow-volume quad splits the wedge: `k_e > 0` is the outer part (samples beyond the projected
 //! edge gain depth complexity), `k_e < 0` the inner part.
 
 use glam::DVec3;
-use rayon::prelude::*;
 
-use crate::centred::{CentredPlane, FastWeight};
-use crate::edges::SceneEdge;
-use crate::light_shape::LightShape;
+use crate::stages::edges::SceneEdge;
+use crate::stages::light_shape::LightShape;
 
 /// One (pixel, silhouette edge) pair: the edge and its weight `k_e(p)`.
 #[derive(Debug, Clone, Copy)]
@@ -51,14 +50,19 @@ impl Plane {
         self.n.dot(x) + self.d >= 0.0
     }
 
-    /// The plane around the light centre `c`, in single precision.
-    fn centred(&self, c: DVec3) -> CentredPlane {
-        CentredPlane::new(self.n, self.d, c)
+    /// The unit normal `n`.
+    pub(crate) fn normal(&self) -> DVec3 {
+        self.n
+    }
+
+    /// The offset `d`.
+    pub(crate) fn offset(&self) -> f64 {
+        self.d
     }
 }
 
 /// Side planes per end point taken from a light polygon with many sides (any subset of valid
-/// planes bounds the wedge; four keep the box tests of [`crate::bins`] within their budget).
+/// planes bounds the wedge; four keep the box tests of [`crate::accel::bins`] within their budget).
 const END_PLANES: usize = 4;
 
 /// Half-spaces that hold the wedge of edge `e` for `light` (see the module documentation):
@@ -244,51 +248,6 @@ fn tangent_candidates(ab: DVec3, a: DVec3, c: DVec3, hull: &[DVec3]) -> Vec<DVec
     out
 }
 
-/// What the wedge scan needs of one silhouette edge, prepared once per light, around the light
-/// centre in single precision.
-#[derive(Debug, Clone)]
-pub(crate) struct Wedge {
-    /// The scene edge.
-    pub edge: u32,
-    /// The half-spaces holding the wedge ([`wedge_planes`]).
-    pub planes: Vec<CentredPlane>,
-    /// The planes of the edge's two faces, oriented by the edge, when the edge's weight can
-    /// only be non-zero where it is a silhouette of the view sample ([`fold_planes`]).
-    pub fold: Option<(CentredPlane, CentredPlane)>,
-    /// The weight from plane signs, for edges with one or two faces.
-    pub weight: Option<FastWeight>,
-}
-
-/// The wedges of every silhouette edge, in silhouette order.
-pub(crate) fn wedges(edges: &[SceneEdge], silhouettes: &[u32], light: &LightShape) -> Vec<Wedge> {
-    let c = light.center.as_dvec3();
-    silhouettes
-        .par_iter()
-        .map(|&ei| {
-            let e = &edges[ei as usize];
-            let weight = FastWeight::new(e, c);
-            // The fold planes are the weight's own face planes where it has them (the same
-            // planes up to scale and rounding), so that the scan hands the fold test's values
-            // to the weight.
-            let fold = fold_planes(e).map(|(a, b)| {
-                weight
-                    .as_ref()
-                    .and_then(FastWeight::face_planes)
-                    .unwrap_or((a.centred(c), b.centred(c)))
-            });
-            Wedge {
-                edge: ei,
-                planes: wedge_planes(e, light)
-                    .iter()
-                    .map(|p| p.centred(c))
-                    .collect(),
-                fold,
-                weight,
-            }
-        })
-        .collect()
-}
-
 /// For a manifold edge whose faces weigh the same, `k_e(p)` is non-zero only where both faces
 /// lie on one side of the plane through `p` and the edge (the edge is a silhouette of `p`):
 /// with `P_i(p) = orient(w_i, a, b, p)` that is `P_1(p) P_2(p) > 0`. Two plane evaluations then
@@ -316,7 +275,7 @@ pub(crate) const FOLD_SLACK: f64 = 1e-6;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::coverage::EdgeTest;
+    use crate::stages::coverage::EdgeTest;
     use glam::Vec3;
     use shadow_core::light::{
         AreaLight, DiskLight, PolygonLight, Radiance, RectLight, SphereLight,

@@ -25,8 +25,8 @@ pub(crate) struct LightShape {
 }
 
 /// A planar light's frame and a convex polygon holding it, with the centre strictly inside:
-/// what the per-pixel light-plane tests need ([`crate::coverage::EdgeTest::may_cover`],
-/// [`crate::angular`]).
+/// what the per-pixel light-plane tests need ([`crate::stages::coverage::EdgeTest::may_cover`],
+/// [`crate::accel::angular`]).
 #[derive(Debug, Clone)]
 pub(crate) struct LightPlane {
     /// First in-plane axis (unit).

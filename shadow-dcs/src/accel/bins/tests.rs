@@ -1,9 +1,10 @@
 //! The wedge search against brute force and its own unrolled forms.
 
 use super::*;
-use crate::edges::{Silhouettes, scene_edges, silhouettes};
-use crate::light_shape::LightShape;
-use crate::wedges::{FOLD_SLACK, wedges};
+use crate::accel::centred_wedges::wedges;
+use crate::stages::edges::{Silhouettes, scene_edges, silhouettes};
+use crate::stages::light_shape::LightShape;
+use crate::stages::wedges::FOLD_SLACK;
 use shadow_core::offset::RayOffset;
 use shadow_core::prelude::*;
 

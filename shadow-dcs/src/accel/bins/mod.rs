@@ -12,13 +12,13 @@
 //!   high depth complexity (`grass`).
 //! * **Tiles** of [`TILE_W`] x [`TILE_H`] pixels: each wedge of a square against the boxes of
 //!   the square's tiles.
-//! * **View samples** of a tile ([`crate::lanes`]): a surviving wedge's fold planes, bounding
+//! * **View samples** of a tile ([`crate::accel::lanes`]): a surviving wedge's fold planes, bounding
 //!   planes and weight `k_e(p)` on every view sample at once; each view sample inside the
 //!   planes with a non-zero weight makes a (pixel, edge) pair. Only the bounding planes that
 //!   may cut the tile's box are evaluated on its view samples ([`ScanWedge::cut_planes`]): a
 //!   plane with the whole box on its positive side holds every view sample in it.
 //!
-//! A box keeps a wedge when none of the wedge's bounding planes ([`crate::wedges::wedge_planes`])
+//! A box keeps a wedge when none of the wedge's bounding planes ([`crate::stages::wedges::wedge_planes`])
 //! has the whole box on its negative side, and the edge may be a silhouette from some point of
 //! the box (its two face planes, with a slack). A test loads one wedge's planes and evaluates
 //! each at the boxes' corners farthest along its normal (and, for the face planes, the nearest
@@ -29,14 +29,15 @@
 use glam::{BVec4A, DVec3, Vec3, Vec4};
 use rayon::prelude::*;
 
-use crate::centred::FastWeight;
-use crate::centred::{CentredEdge, CentredPlane};
-use crate::edges::SceneEdge;
-use crate::lanes::{
+use crate::accel::centred::FastWeight;
+use crate::accel::centred::{CentredEdge, CentredPlane};
+use crate::accel::centred_wedges::Wedge;
+use crate::accel::lanes::{
     LANES, LaneMask, QUADS, TILE_H, TILE_W, TileLanes, TileQuads, lanes_of, rect_lanes,
 };
-use crate::planar::{PlanarEdge, PlanarTest};
-use crate::wedges::{Pair, Wedge};
+use crate::accel::planar::{PlanarEdge, PlanarTest};
+use crate::stages::edges::SceneEdge;
+use crate::stages::wedges::Pair;
 
 mod boxes;
 mod hierarchy;

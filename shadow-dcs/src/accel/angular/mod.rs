@@ -1,7 +1,7 @@
 //! A per-pixel angular index of the light samples (planar lights), after the sector table of
 //! DCS section 7.3 (Fig. 8) but built for each pixel's own samples, so that it serves
 //! stratified and decorrelated sampling, and used only to find candidates: the exact test of
-//! [`crate::coverage`] still decides every candidate.
+//! [`crate::stages::coverage`] still decides every candidate.
 //!
 //! The samples an edge covers lie in its angular sector around the light centre `c`: one cone
 //! between the lines where the planes `(p, c, a)` and `(p, c, b)` cut the light plane
@@ -16,9 +16,9 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use crate::coverage::EdgeTest;
-use crate::light_shape::LightPlane;
-use crate::planar::{PlanarSamples, PlanarTest};
+use crate::accel::planar::{PlanarSamples, PlanarTest};
+use crate::stages::coverage::EdgeTest;
+use crate::stages::light_shape::LightPlane;
 
 /// Angular buckets over a whole turn.
 pub(crate) const BUCKETS: usize = 256;

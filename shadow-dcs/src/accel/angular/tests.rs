@@ -1,8 +1,8 @@
 //! The angular index against the exact test on every sample.
 
 use super::*;
-use crate::coverage::RelativeSamples;
-use crate::light_shape::LightShape;
+use crate::stages::coverage::RelativeSamples;
+use crate::stages::light_shape::LightShape;
 use glam::DVec3;
 use shadow_core::light::AreaLight;
 use shadow_core::light::{Radiance, RectLight};
@@ -229,9 +229,9 @@ fn light_plane_candidates_hold_every_covered_sample() {
 }
 
 fn light_plane_candidates_of<const W: usize>() {
-    use crate::centred::CentredEdge;
-    use crate::edges::SceneEdge;
-    use crate::planar::{PlanarEdge, PlanarSamples};
+    use crate::accel::centred::CentredEdge;
+    use crate::accel::planar::{PlanarEdge, PlanarSamples};
+    use crate::stages::edges::SceneEdge;
     let light = test_light(Vec3::new(0.1, -1.0, 0.05));
     let shape = LightShape::new(&light, "test").unwrap();
     let plane = shape.plane.clone().unwrap();

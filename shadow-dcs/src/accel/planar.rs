@@ -21,7 +21,7 @@
 
 use glam::{DVec3, Vec2, Vec3, Vec4};
 
-use crate::edges::SceneEdge;
+use crate::stages::edges::SceneEdge;
 
 /// Relative error bound of the orientation `(a' x b') . p'` in single precision, against
 /// `|a' x b'| . |p'|` (componentwise absolute values): the rounding of the prepared vector and
@@ -70,7 +70,7 @@ impl PlanarEdge {
     }
 
     /// The test from the centred view sample `p` (`p_norm` at least its length), `None` on the
-    /// tie of [`EdgeTest::new`](crate::coverage::EdgeTest) (the edge's line meets the line
+    /// tie of [`EdgeTest::new`](crate::stages::coverage::EdgeTest) (the edge's line meets the line
     /// `p c`). `exact` gives the orientation (`Some(orient(a, b, p, c) > 0)`, `None` on the
     /// tie) when single precision cannot tell it.
     #[inline(always)]
@@ -296,8 +296,8 @@ impl RectMap {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::centred::CentredEdge;
-    use crate::coverage::EdgeTest;
+    use crate::accel::centred::CentredEdge;
+    use crate::stages::coverage::EdgeTest;
     use shadow_core::sampling::{hash_words, unit_float};
 
     fn edge(a: DVec3, b: DVec3) -> SceneEdge {
@@ -310,7 +310,7 @@ mod tests {
     /// with sides orthogonal only within the light's tolerance, the normal either way round.
     #[test]
     fn rectangle_coordinates_from_unit_samples_equal_those_of_positions() {
-        use crate::light_shape::LightShape;
+        use crate::stages::light_shape::LightShape;
         use shadow_core::light::{AreaLight, RectLight};
         use shadow_core::prelude::Radiance;
         for case in 0..6u64 {

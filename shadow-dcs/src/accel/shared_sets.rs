@@ -4,7 +4,7 @@
 //! Under correlated sampling every pixel takes the same set, and under interleaved sampling
 //! (DCS section 5, Fig. 5) the pixels at one place of a `k x k` tile do. Their samples' world
 //! positions, their coordinates in the light plane around its centre and the angular index
-//! built on those ([`crate::angular`]) are then the same for every such pixel: only what
+//! built on those ([`crate::accel::angular`]) are then the same for every such pixel: only what
 //! depends on the view sample (the horizon mask, the samples relative to it) is computed per
 //! pixel. Each thread keeps the sets it has met for the length of one estimate, built the
 //! first time a pixel needs them, and lends a set to the pixel's scratch by swapping buffers,
@@ -13,8 +13,8 @@
 
 use glam::Vec3;
 
-use crate::angular::AngularIndex;
-use crate::planar::PlanarSamples;
+use crate::accel::angular::AngularIndex;
+use crate::accel::planar::PlanarSamples;
 
 /// How a pixel's samples are set up: the keys of one shared set's forms are apart, since the
 /// forms give the same points up to rounding only.

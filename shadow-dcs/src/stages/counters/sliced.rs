@@ -261,7 +261,7 @@ mod tests {
             assert_eq!(more_than_two_bits(k), k.count_ones() > 2, "{k:#x}");
         }
     }
-    use crate::counters::WIDTHS;
+    use crate::stages::counters::WIDTHS;
 
     #[test]
     fn zero_masks_match_the_counters() {
@@ -317,7 +317,7 @@ mod tests {
     #[test]
     fn overflow_and_underflow_are_detected_not_wrapped() {
         let mut p = BitSliced::default();
-        crate::counters::check_range_errors(&mut p, |p, i| p.get(i));
+        crate::stages::counters::check_range_errors(&mut p, |p, i| p.get(i));
         // Wide weights down and up (one pass of a full adder), many words.
         p.reset(16, 100, 1000).unwrap();
         let m = [0xf0f0_f0f0_0f0f_0f0f, 0xffff_0000_ffff];

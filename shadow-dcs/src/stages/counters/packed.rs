@@ -139,7 +139,7 @@ impl Packed {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::counters::WIDTHS;
+    use crate::stages::counters::WIDTHS;
 
     #[test]
     fn spread_puts_each_bit_in_its_lane() {
@@ -188,7 +188,7 @@ mod tests {
     #[test]
     fn overflow_and_underflow_are_detected_not_wrapped() {
         let mut p = Packed::default();
-        crate::counters::check_range_errors(&mut p, |p, i| p.get(i));
+        crate::stages::counters::check_range_errors(&mut p, |p, i| p.get(i));
         p.reset(8, 16, 250).unwrap();
         let mask = [0b10u64];
         p.add(&mask, 5).unwrap();

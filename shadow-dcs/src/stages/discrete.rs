@@ -25,9 +25,9 @@ use shadow_core::light::{AreaLight, LightGeometry};
 use shadow_core::sampling::{LightSampler, SamplingStrategy};
 use shadow_core::technique::{TechniqueError, UnsupportedReason};
 
-use crate::coverage::{EdgeTest, RelativeSamples};
-use crate::edges::SceneEdge;
-use crate::light_shape::LightShape;
+use crate::stages::coverage::{EdgeTest, RelativeSamples};
+use crate::stages::edges::SceneEdge;
+use crate::stages::light_shape::LightShape;
 
 /// Angular resolution of the sector table.
 pub const ANGLE_BINS: usize = 4096;
@@ -48,7 +48,7 @@ pub enum CoveredSamples {
     /// exact test. Exact like [`CoveredSamples::Exact`].
     ///
     /// In a pixel with at least 6 wedge pairs the sector part comes from the pixel's angular
-    /// index (the sector table of its own samples, `crate::angular`): a pair whose sector holds
+    /// index (the sector table of its own samples, `crate::accel::angular`): a pair whose sector holds
     /// at most 12 candidates tests them exactly, one with more looks its line up in the line
     /// table, which settles the candidates in the sector's inner buckets surely beyond the line
     /// and drops those surely before it. On `bunny` at 512x512 this runs in 0.23 s against
@@ -412,7 +412,7 @@ fn angle_bin(v: DVec2) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::coverage::RelativeSamples;
+    use crate::stages::coverage::RelativeSamples;
     use glam::Vec3;
     use shadow_core::light::{Radiance, RectLight};
     use shadow_core::sampling::{hash_words, unit_float};

@@ -24,7 +24,7 @@ use glam::{DVec3, Vec3};
 use shadow_core::scene::Scene;
 use shadow_core::topology::EdgeKind;
 
-use crate::light_shape::LightShape;
+use crate::stages::light_shape::LightShape;
 
 /// Opacity units of one fully opaque surface when the scene has semi-opaque occluders.
 pub const OPACITY_UNITS: u32 = 255;

@@ -88,7 +88,7 @@ pub(crate) struct EdgeTest {
 impl EdgeTest {
     /// The test of edge `a b` seen from `p` with the light centre `c`; `None` when the line of
     /// the edge meets the line `p c` (no sample can be covered robustly). The technique builds
-    /// the same test from light-centred data ([`crate::centred::CentredEdge`]); this direct form
+    /// the same test from light-centred data ([`crate::accel::centred::CentredEdge`]); this direct form
     /// is what tests check it against.
     #[cfg(test)]
     pub fn new(p: DVec3, c: DVec3, a: DVec3, b: DVec3) -> Option<Self> {
@@ -135,7 +135,7 @@ impl EdgeTest {
 
     /// `+-orient(p, c, s, a)` and `+-orient(p, c, s, b)` as linear functions of `s - p`: their
     /// zero sets are the planes through `p`, `c` and an end point, which bound the angular
-    /// sector (used by [`crate::angular`]); covered samples have the first positive and the
+    /// sector (used by [`crate::accel::angular`]); covered samples have the first positive and the
     /// second negative.
     pub fn sector_normals(&self) -> (Vec3, Vec3) {
         (self.ga, self.gb)

@@ -16,9 +16,9 @@
 
 use glam::{DVec3, Vec3, Vec4};
 
-use crate::coverage::EdgeTest;
-use crate::edges::SceneEdge;
-use crate::lanes::{LANES, LaneMask, QUADS, TileQuads};
+use crate::accel::lanes::{LANES, LaneMask, QUADS, TileQuads};
+use crate::stages::coverage::EdgeTest;
+use crate::stages::edges::SceneEdge;
 
 /// Relative error bound of an `f32` plane evaluation, against `|n|_1 |x'|_1 + |d|`. The value
 /// carries the rounding of `n` and `d` to `f32` (one unit in the last place, `6e-8`, each), of
@@ -298,8 +298,8 @@ impl CentredEdge {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::edges::EdgeFace;
-    use crate::lanes::{TILE_H, TILE_W, TileLanes, rect_lanes};
+    use crate::accel::lanes::{TILE_H, TILE_W, TileLanes, rect_lanes};
+    use crate::stages::edges::EdgeFace;
     use shadow_core::sampling::{hash_words, unit_float};
 
     fn face(a: DVec3, b: DVec3, third: DVec3, flip: bool, two_sided: bool) -> EdgeFace {
