@@ -3,6 +3,7 @@
 //! scan, and the estimate and direct illumination assembled from the per-pixel pass
 //! ([`super::pixel`]).
 
+use super::pixel::PixelPass;
 use super::*;
 
 impl Dcs {
@@ -114,7 +115,16 @@ impl Dcs {
             let i = y as usize * w + x as usize;
             let Some(s) = view.get_at(x, y) else { continue };
             let (entries, tests) = pairs.of(j);
-            let class = self.pixel(p, f, i, &s, entries, tests, scratch, counts);
+            let class = PixelPass {
+                dcs: self,
+                p,
+                f,
+                i,
+                s: &s,
+                scratch,
+                counts,
+            }
+            .run(entries, tests);
             visit(i, &s, class, scratch);
         }
     }

@@ -219,6 +219,35 @@ struct Refined<'a> {
     pixel: UVec2,
 }
 
+/// A pixel's per-sample updates of Algorithm 1, collected before the counters run (outer
+/// wedges first, section 4.4): per pair that covers any sample, the covered samples (a mask of
+/// the pixel's sample words) and the pair's weight `k_e(p)`. Every covered-sample test (exact,
+/// table, light-plane, with or without the angular index) ends in [`Updates::push`], the one
+/// place an update is recorded.
+#[derive(Debug, Default)]
+pub(super) struct Updates {
+    /// The covered-sample masks, one after the other.
+    pub(super) masks: Vec<u64>,
+    /// The weight of each mask.
+    pub(super) weights: Vec<i64>,
+}
+
+impl Updates {
+    /// Records that the samples of `mask` gain `k` layers (counted in `covered_updates`).
+    #[inline(always)]
+    pub(super) fn push(&mut self, mask: &[u64], k: i64, covered_updates: &mut u64) {
+        self.masks.extend_from_slice(mask);
+        self.weights.push(k);
+        *covered_updates += 1;
+    }
+
+    /// Forgets every update (a new pixel).
+    pub(super) fn clear(&mut self) {
+        self.masks.clear();
+        self.weights.clear();
+    }
+}
+
 /// Per-thread buffers.
 #[derive(Default)]
 struct Scratch {
@@ -244,8 +273,8 @@ struct Scratch {
     /// Per waiting test, the candidates in its sector's inner buckets (refined tables only).
     batch_inner: Vec<u64>,
     undecided: Vec<u64>,
-    masks: Vec<u64>,
-    weights: Vec<i64>,
+    /// The pixel's per-sample updates, in pair order ([`Updates`]).
+    updates: Updates,
     packed: Packed,
     sliced: BitSliced,
     plain: Vec<i64>,

@@ -5,56 +5,39 @@
 
 use super::*;
 
-impl Dcs {
-    /// The horizon class of a receiver: the reference's rule, a sample counts when it lies
-    /// above the tangent plane both from the surface point and from the offset origin.
-    pub(super) fn horizon(shape: &LightShape, s: &ViewSample, origin: Vec3) -> Horizon {
-        let n = s.geometric_normal.as_dvec3();
-        let [(lo1, hi1), (lo2, hi2)] =
-            shape.ranges(n, -n.dot(s.position.as_dvec3()), -n.dot(origin.as_dvec3()));
-        let reach = shape.center.as_dvec3().length() + f64::from(shape.radius);
-        let bound = HORIZON_BOUND
-            * n.length()
-            * (reach
-                + s.position
-                    .as_dvec3()
-                    .length()
-                    .max(origin.as_dvec3().length()));
-        if lo1 > bound && lo2 > bound {
-            Horizon::Above
-        } else if lo1 > 0.0 && lo2 > 0.0 {
-            Horizon::Grazing
-        } else if !(hi1 > 0.0 && hi2 > 0.0) {
-            Horizon::Below
-        } else {
-            Horizon::Mixed
-        }
-    }
+/// One view sample's pass (Algorithm 1 for one pixel): what each of its steps reads (the
+/// technique, its preparation, the frame, the pixel) and writes (the scratch, the counts).
+pub(super) struct PixelPass<'a, 'v> {
+    /// The configuration.
+    pub(super) dcs: &'a Dcs,
+    /// The scene and light as prepared.
+    pub(super) p: &'a Prepared,
+    /// The frame (view samples, constants, horizons).
+    pub(super) f: &'a Frame<'v>,
+    /// The pixel's index in the view.
+    pub(super) i: usize,
+    /// The pixel's view sample.
+    pub(super) s: &'a ViewSample,
+    /// Per-thread buffers the pass fills.
+    pub(super) scratch: &'a mut Scratch,
+    /// Work counts.
+    pub(super) counts: &'a mut Counts,
+}
 
+impl PixelPass<'_, '_> {
     /// Per-sample visibility of pixel `i` into `scratch.visible` (with `scratch.want_values`,
     /// also `scratch.vis` and depth complexities into `scratch.depth`), and its samples'
     /// radiances into `scratch.radiances` when the light is textured (they weigh eq. 2; none for
     /// a pixel whose integration constant alone puts it in the umbra; the whole light samples
     /// into `scratch.samples` only where the samples were set up), from its
     /// wedge pairs `entries` (and, for the light-plane test, their `tests`). Returns the class.
-    #[expect(
-        clippy::too_many_arguments,
-        reason = "the per-pixel pass hands its prepared data, frame, pixel, scratch and counters down the hot path"
-    )]
-    pub(super) fn pixel(
-        &self,
-        p: &Prepared,
-        f: &Frame,
-        i: usize,
-        s: &ViewSample,
-        entries: &[Pair],
-        tests: &[PlanarTest],
-        scratch: &mut Scratch,
-        counts: &mut Counts,
-    ) -> PixelClass {
+    pub(super) fn run(&mut self, entries: &[Pair], tests: &[PlanarTest]) -> PixelClass {
+        let Self {
+            dcs, p, f, i, s, ..
+        } = *self;
         // The refined tables of section 7.3 settle what they can of the index's candidates.
         let pc = f.origins[i].as_dvec3() - p.shape.center.as_dvec3();
-        let refined = match (self.covered, &p.tables) {
+        let refined = match (dcs.covered, &p.tables) {
             (CoveredSamples::Refined, Some(t)) => Some(Refined {
                 tables: t,
                 edges: &p.centred_edges,
@@ -65,13 +48,13 @@ impl Dcs {
         };
         let pairs = entries.len() + tests.len();
         let indexed = p.shape.plane.is_some()
-            && (self.covered == CoveredSamples::Exact || refined.is_some())
+            && (dcs.covered == CoveredSamples::Exact || refined.is_some())
             && pairs >= INDEX_MIN_PAIRS;
-        let Some(mut start) = self.pixel_start(p, f, i, s, indexed, scratch, counts) else {
+        let Some(mut start) = self.start(indexed) else {
             return PixelClass::Skipped;
         };
         if let (Some(poly), false) = (&p.polygon, pairs == 0) {
-            scratch.polygon.set(poly, f.centred[i]);
+            self.scratch.polygon.set(poly, f.centred[i]);
         }
         // Each pair's covered-sample test. The light-overlap test decides whether the pixel
         // needs per-sample work at all: its samples are set up at the first pair that may cover
@@ -81,69 +64,51 @@ impl Dcs {
         debug_assert!(start.planar || tests.is_empty());
         debug_assert!(!start.planar || entries.is_empty());
         if !tests.is_empty() {
-            self.ensure_ready(p, f, i, s, &mut start, scratch, counts);
-            Self::planar_pairs(tests, indexed, scratch, counts);
+            self.ensure_ready(&mut start);
+            Dcs::planar_pairs(tests, indexed, self.scratch, self.counts);
         }
         for pair in entries {
             let Some(test) = p.centred_edges[pair.edge as usize].test(pc) else {
-                counts.ties += 1;
+                self.counts.ties += 1;
                 continue;
             };
             if (!start.ready || !indexed)
                 && p.polygon.is_some()
-                && !test.may_cover(&scratch.polygon)
+                && !test.may_cover(&self.scratch.polygon)
             {
-                counts.off_light += 1;
+                self.counts.off_light += 1;
                 continue;
             }
-            self.ensure_ready(p, f, i, s, &mut start, scratch, counts);
+            self.ensure_ready(&mut start);
             if indexed {
                 // Candidates a batch at a time (their sector arithmetic vectorises).
+                let scratch = &mut *self.scratch;
                 scratch.batch.push(test);
                 scratch.batch_k.push(pair.k as i64);
                 if refined.is_some() {
                     scratch.batch_edge.push(pair.edge);
                 }
                 if scratch.batch.len() == BATCH {
-                    Self::indexed_updates(scratch, counts, refined.as_ref());
+                    Dcs::indexed_updates(scratch, self.counts, refined.as_ref());
                 }
             } else {
-                self.covered_update(
-                    p,
-                    s,
-                    pc + p.shape.center.as_dvec3(),
-                    pair,
-                    &test,
-                    scratch,
-                    counts,
-                );
+                self.covered_update(pc + p.shape.center.as_dvec3(), pair, &test);
             }
         }
-        if !scratch.batch.is_empty() {
-            Self::indexed_updates(scratch, counts, refined.as_ref());
+        if !self.scratch.batch.is_empty() {
+            Dcs::indexed_updates(self.scratch, self.counts, refined.as_ref());
         }
-        self.pixel_finish(p, f, s, &start, scratch, counts)
+        self.finish(&start)
     }
 
     /// The start of pixel `i`'s pass: its scratch emptied, its class when it faces away from the
     /// whole light (`None`, its values set), else its integration constant and whether it takes
     /// the light-plane test, with its samples set up at once when the horizon cuts the light
     /// (`indexed`: with the angular index).
-    #[expect(
-        clippy::too_many_arguments,
-        reason = "the per-pixel pass hands its prepared data, frame, pixel, scratch and counters down the hot path"
-    )]
-    pub(super) fn pixel_start(
-        &self,
-        p: &Prepared,
-        f: &Frame,
-        i: usize,
-        s: &ViewSample,
-        indexed: bool,
-        scratch: &mut Scratch,
-        counts: &mut Counts,
-    ) -> Option<PixelStart> {
-        let n = self.sampler.count() as usize;
+    fn start(&mut self, indexed: bool) -> Option<PixelStart> {
+        let Self { dcs, f, i, .. } = *self;
+        let (scratch, counts) = (&mut *self.scratch, &mut *self.counts);
+        let n = dcs.sampler.count() as usize;
         let horizon = f.horizon[i];
         scratch.vis.clear();
         scratch.depth.clear();
@@ -151,8 +116,7 @@ impl Dcs {
         scratch.radiances.clear();
         scratch.visible.clear();
         scratch.visible.resize(n.div_ceil(64), 0);
-        scratch.masks.clear();
-        scratch.weights.clear();
+        scratch.updates.clear();
         if horizon == Horizon::Below {
             counts.facing_away += 1;
             if scratch.want_values {
@@ -175,54 +139,26 @@ impl Dcs {
             ready: false,
         };
         if horizon == Horizon::Mixed {
-            self.ensure_ready(p, f, i, s, &mut start, scratch, counts);
+            self.ensure_ready(&mut start);
         }
         Some(start)
     }
 
     /// Sets the pixel's samples up unless they are.
-    #[expect(
-        clippy::too_many_arguments,
-        reason = "the per-pixel pass hands its prepared data, frame, pixel, scratch and counters down the hot path"
-    )]
-    pub(super) fn ensure_ready(
-        &self,
-        p: &Prepared,
-        f: &Frame,
-        i: usize,
-        s: &ViewSample,
-        start: &mut PixelStart,
-        scratch: &mut Scratch,
-        counts: &mut Counts,
-    ) {
+    fn ensure_ready(&mut self, start: &mut PixelStart) {
         if !start.ready {
-            let all_above = f.horizon[i] == Horizon::Above;
-            self.sample_setup(
-                p,
-                s,
-                f.origins[i],
-                start.indexed,
-                all_above,
-                start.planar,
-                scratch,
-                counts,
-            );
+            let all_above = self.f.horizon[self.i] == Horizon::Above;
+            self.sample_setup(start.indexed, all_above, start.planar);
             start.ready = true;
         }
     }
 
     /// The end of a pixel's pass: its integration constant for every sample when it set no
     /// sample up, else its counters from the updates in `scratch`; returns its class.
-    pub(super) fn pixel_finish(
-        &self,
-        p: &Prepared,
-        f: &Frame,
-        s: &ViewSample,
-        start: &PixelStart,
-        scratch: &mut Scratch,
-        counts: &mut Counts,
-    ) -> PixelClass {
-        let n = self.sampler.count() as usize;
+    fn finish(&mut self, start: &PixelStart) -> PixelClass {
+        let Self { dcs, p, f, s, .. } = *self;
+        let (scratch, counts) = (&mut *self.scratch, &mut *self.counts);
+        let n = dcs.sampler.count() as usize;
         let words = n.div_ceil(64);
         let d0 = start.d0;
         let units = p.units as f32;
@@ -242,7 +178,7 @@ impl Dcs {
             // In the umbra every sample's weight is zero: eq. 2 needs no radiance. Elsewhere
             // only the radiances, not the positions.
             if textured && v > 0.0 {
-                self.sampler.unit_samples(s.pixel, &mut scratch.units);
+                dcs.sampler.unit_samples(s.pixel, &mut scratch.units);
                 let light = p.light.as_ref();
                 light.radiances_into(&scratch.units, &mut scratch.radiances);
             }
@@ -260,7 +196,7 @@ impl Dcs {
         // counters are read, the paper's lanes when every depth complexity is.
         let mut done = false;
         for bits in WIDTHS.into_iter().filter(|&b| b >= f.bits) {
-            let (masks, weights) = (&scratch.masks, &scratch.weights);
+            let (masks, weights) = (&scratch.updates.masks, &scratch.updates.weights);
             let fits = if values {
                 counters::run(&mut scratch.packed, bits, n, d0, masks, weights)
             } else {
@@ -301,7 +237,8 @@ impl Dcs {
             counts.plain_fallback += 1;
             scratch.plain.clear();
             scratch.plain.resize(n, d0 as i64);
-            for (m, &k) in scratch.masks.chunks(words).zip(&scratch.weights) {
+            let u = &scratch.updates;
+            for (m, &k) in u.masks.chunks(words).zip(&u.weights) {
                 for j in 0..n {
                     if m[j / 64] >> (j % 64) & 1 == 1 {
                         scratch.plain[j] = scratch.plain[j].saturating_add(k);
@@ -351,24 +288,15 @@ impl Dcs {
     /// view sample (in the light plane with `planar`), the angular index (`indexed`), and empty
     /// update lists. What depends on the samples alone comes from the pixel's shared set when
     /// it has one (correlated and interleaved sampling, [`crate::accel::shared_sets`]), built once.
-    #[expect(
-        clippy::too_many_arguments,
-        reason = "the per-pixel pass hands its prepared data, frame, pixel, scratch and counters down the hot path"
-    )]
-    pub(super) fn sample_setup(
-        &self,
-        p: &Prepared,
-        s: &ViewSample,
-        origin: Vec3,
-        indexed: bool,
-        all_above: bool,
-        planar: bool,
-        scratch: &mut Scratch,
-        counts: &mut Counts,
-    ) {
-        let n = self.sampler.count() as usize;
+    fn sample_setup(&mut self, indexed: bool, all_above: bool, planar: bool) {
+        let Self {
+            dcs, p, f, i, s, ..
+        } = *self;
+        let (scratch, counts) = (&mut *self.scratch, &mut *self.counts);
+        let origin = f.origins[i];
+        let n = dcs.sampler.count() as usize;
         let words = n.div_ceil(64);
-        self.sampler.unit_samples(s.pixel, &mut scratch.units);
+        dcs.sampler.unit_samples(s.pixel, &mut scratch.units);
         let light = p.light.as_ref();
         scratch.samples.clear();
         scratch.radiances.clear();
@@ -384,15 +312,15 @@ impl Dcs {
         // The radiances of a textured light weigh the visibilities (eq. 2): its pixels set
         // their samples up themselves.
         let textured = light.is_textured();
-        let shared = (self.share_sets && !textured)
-            .then(|| self.sampler.shared_set(s.pixel))
+        let shared = (dcs.share_sets && !textured)
+            .then(|| dcs.sampler.shared_set(s.pixel))
             .flatten();
         let units = &scratch.units;
         match shared {
             Some(k) => {
                 // Built with its index, which the pixels of the set that take one then share.
                 let built = scratch.shared.lend(k, form, &mut scratch.set, |set| {
-                    self.set_up_samples(p, form, units, true, set);
+                    Dcs::set_up_samples(p, form, units, true, set);
                 });
                 counts.shared_sets_built += u64::from(built);
                 counts.shared_set_pixels += 1;
@@ -410,7 +338,7 @@ impl Dcs {
                         .radiances
                         .extend(scratch.samples.iter().map(|l| l.radiance));
                 }
-                self.set_up_samples(p, form, units, indexed, &mut scratch.set);
+                Dcs::set_up_samples(p, form, units, indexed, &mut scratch.set);
             }
         }
         // Samples above the horizon (the reference's rule), every one when the whole light is
@@ -432,8 +360,7 @@ impl Dcs {
         } else {
             horizon_mask_into(&scratch.set.positions, s, origin, &mut scratch.above);
         }
-        scratch.masks.clear();
-        scratch.weights.clear();
+        scratch.updates.clear();
         if form == SetForm::Spatial {
             scratch.relative.set(origin, &scratch.set.positions);
         }
@@ -441,12 +368,64 @@ impl Dcs {
         scratch.mask.resize(words, 0);
     }
 
+    /// The samples one pair's edge covers (section 7.3 tables, or the exact test on every
+    /// sample above the horizon), appended to the pixel's updates when there is any.
+    fn covered_update(&mut self, o: DVec3, pair: &Pair, test: &EdgeTest) {
+        let Self { dcs, p, s, .. } = *self;
+        let (scratch, counts) = (&mut *self.scratch, &mut *self.counts);
+        counts.edge_tests += 1;
+        let mask = &mut scratch.mask;
+        let any = match (&dcs.covered, &p.tables) {
+            (CoveredSamples::Discrete | CoveredSamples::Refined, Some(t)) => t.mask(
+                s.pixel,
+                test,
+                o,
+                &p.edges[p.silhouettes[pair.edge as usize] as usize],
+                &scratch.relative,
+                &scratch.above,
+                mask,
+            ),
+            _ => test.mask(&scratch.relative, &scratch.above, mask),
+        };
+        if any {
+            scratch
+                .updates
+                .push(mask, pair.k as i64, &mut counts.covered_updates);
+        }
+    }
+}
+
+impl Dcs {
+    /// The horizon class of a receiver: the reference's rule, a sample counts when it lies
+    /// above the tangent plane both from the surface point and from the offset origin.
+    pub(super) fn horizon(shape: &LightShape, s: &ViewSample, origin: Vec3) -> Horizon {
+        let n = s.geometric_normal.as_dvec3();
+        let [(lo1, hi1), (lo2, hi2)] =
+            shape.ranges(n, -n.dot(s.position.as_dvec3()), -n.dot(origin.as_dvec3()));
+        let reach = shape.center.as_dvec3().length() + f64::from(shape.radius);
+        let bound = HORIZON_BOUND
+            * n.length()
+            * (reach
+                + s.position
+                    .as_dvec3()
+                    .length()
+                    .max(origin.as_dvec3().length()));
+        if lo1 > bound && lo2 > bound {
+            Horizon::Above
+        } else if lo1 > 0.0 && lo2 > 0.0 {
+            Horizon::Grazing
+        } else if !(hi1 > 0.0 && hi2 > 0.0) {
+            Horizon::Below
+        } else {
+            Horizon::Mixed
+        }
+    }
+
     /// What a pixel's samples need of their unit samples `units` alone, in `form`, into `set`:
     /// the world positions (unless already there, as a textured light's samples put them;
     /// none for the rectangle form outside debug builds), the light-plane coordinates (the
     /// light-plane forms) and, with `indexed`, the angular index.
     pub(super) fn set_up_samples(
-        &self,
         p: &Prepared,
         form: SetForm,
         units: &[Vec2],
@@ -473,43 +452,6 @@ impl Dcs {
         }
         if indexed {
             set.angular.build_planar(&set.planar, n);
-        }
-    }
-
-    /// The samples one pair's edge covers (section 7.3 tables, or the exact test on every
-    /// sample above the horizon), appended to the pixel's updates when there is any.
-    #[expect(
-        clippy::too_many_arguments,
-        reason = "the per-pixel pass hands its prepared data, frame, pixel, scratch and counters down the hot path"
-    )]
-    pub(super) fn covered_update(
-        &self,
-        p: &Prepared,
-        s: &ViewSample,
-        o: DVec3,
-        pair: &Pair,
-        test: &EdgeTest,
-        scratch: &mut Scratch,
-        counts: &mut Counts,
-    ) {
-        counts.edge_tests += 1;
-        let mask = &mut scratch.mask;
-        let any = match (&self.covered, &p.tables) {
-            (CoveredSamples::Discrete | CoveredSamples::Refined, Some(t)) => t.mask(
-                s.pixel,
-                test,
-                o,
-                &p.edges[p.silhouettes[pair.edge as usize] as usize],
-                &scratch.relative,
-                &scratch.above,
-                mask,
-            ),
-            _ => test.mask(&scratch.relative, &scratch.above, mask),
-        };
-        if any {
-            counts.covered_updates += 1;
-            scratch.masks.extend_from_slice(mask);
-            scratch.weights.push(pair.k as i64);
         }
     }
 
@@ -579,9 +521,7 @@ impl Dcs {
                 None => test.mask(&scratch.relative, cand, mask),
             };
             if covered {
-                counts.covered_updates += 1;
-                scratch.masks.extend_from_slice(mask);
-                scratch.weights.push(*k);
+                scratch.updates.push(mask, *k, &mut counts.covered_updates);
             }
         }
         scratch.batch.clear();
@@ -649,9 +589,11 @@ impl Dcs {
                     }
                 }
                 if hit != 0 {
-                    counts.covered_updates += 1;
-                    scratch.masks.extend_from_slice(&scratch.mask);
-                    scratch.weights.push(i64::from(test.k));
+                    scratch.updates.push(
+                        &scratch.mask,
+                        i64::from(test.k),
+                        &mut counts.covered_updates,
+                    );
                 }
             }
         }
@@ -676,7 +618,7 @@ impl Dcs {
         let Some(rows) = scratch.set.angular.rows::<W>() else {
             return false;
         };
-        let (masks, weights) = (&mut scratch.masks, &mut scratch.weights);
+        let updates = &mut scratch.updates;
         let (mut empty, mut covered) = (0, 0);
         let mut quad_of = |four: &[PlanarTest; 4], n: usize| {
             let r = QuadRanges::of_tests(four);
@@ -694,9 +636,7 @@ impl Dcs {
                 let hit: [u64; W] =
                     std::array::from_fn(|w| test.covered_of(&xs[w], &ys[w], cand[w]));
                 if hit.iter().any(|h| *h != 0) {
-                    covered += 1;
-                    masks.extend_from_slice(&hit);
-                    weights.push(i64::from(test.k));
+                    updates.push(&hit, i64::from(test.k), &mut covered);
                 }
             }
         };
