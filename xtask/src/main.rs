@@ -10,6 +10,7 @@
 
 mod auto_study;
 mod bench;
+mod bench_summary;
 mod budgets;
 mod common;
 mod conformance;
