@@ -3,7 +3,7 @@
 //! width, plus the exact fraction of the light above a receiver's tangent plane.
 
 use glam::{DVec3, Vec3};
-use shadow_core::light::{AreaLight, LightGeometry};
+use shadow_core::light::AreaLight;
 use shadow_core::technique::{TechniqueError, UnsupportedReason};
 
 /// Sides of the polygon standing for a disk light.
@@ -31,39 +31,14 @@ impl LightFrame {
     /// # Errors
     /// [`TechniqueError::Unsupported`] for sphere and point lights.
     pub fn new(light: &dyn AreaLight, technique: &str) -> Result<Self, TechniqueError> {
-        let (axis, outline) = match light.geometry() {
-            LightGeometry::Rectangle {
-                center,
-                half_u,
-                half_v,
-                normal,
-            } => (
-                normal,
-                vec![
-                    center - half_u - half_v,
-                    center + half_u - half_v,
-                    center + half_u + half_v,
-                    center - half_u + half_v,
-                ],
-            ),
-            LightGeometry::Polygon { outline, normal } => (normal, outline.to_vec()),
-            LightGeometry::Disk {
-                center,
-                normal,
-                radius,
-            } => {
-                let (t1, t2) = shadow_core::geometry::orthonormal_basis(normal);
-                let v = (0..DISK_SIDES)
-                    .map(|k| {
-                        let a = k as f32 * std::f32::consts::TAU / DISK_SIDES as f32;
-                        center + (t1 * a.cos() + t2 * a.sin()) * radius
-                    })
-                    .collect();
-                (normal, v)
-            }
-            LightGeometry::Sphere { .. }
-            | LightGeometry::Point { .. }
-            | LightGeometry::Mesh { .. } => {
+        let geometry = light.geometry();
+        let (axis, outline) = match (
+            geometry.plane_normal(),
+            geometry.planar_outline(DISK_SIDES as u32, |r| r),
+        ) {
+            // The outline shared with the other techniques; a disk's is inscribed.
+            (Some(normal), Some(outline)) => (normal, outline),
+            _ => {
                 return Err(TechniqueError::unsupported(
                     technique,
                     UnsupportedReason::Light {

@@ -702,10 +702,11 @@ fn write_summary(a: &BenchArgs, points: &[Point], truth_samples: u32) -> Result<
         })
         .collect();
     let heading = format!(
-        "`cargo xtask bench{} --scenes {} --repeats {}{}` ({}, {} threads, {}), {}x{} pixels, \
-         errors against the reference at {truth_samples} samples with another seed, medians of \
-         {} runs after a warm-up.",
+        "`cargo xtask bench{}{} --scenes {} --repeats {}{}` ({}, {} threads, {}), {}x{} \
+         pixels, errors against the reference at {truth_samples} samples with another seed, \
+         medians of {} runs after a warm-up.",
         if a.quick { " --quick" } else { "" },
+        if a.study_only { " --study-only" } else { "" },
         a.scenes.join(","),
         a.repeats,
         if a.techniques.is_empty() {

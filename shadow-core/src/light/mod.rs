@@ -244,6 +244,51 @@ impl LightGeometry<'_> {
         }
     }
 
+    /// The outline of a planar light, counter-clockwise around its normal: a rectangle's four
+    /// corners, a polygon's outline, and for a disk `disk_sides` points at angles
+    /// `k 2 pi / disk_sides` from the first axis of [`crate::geometry::orthonormal_basis`] on
+    /// the circle of radius `disk_radius(radius)` (the radius itself for an inscribed polygon;
+    /// `radius / cos(pi / disk_sides)` or more for one that holds the disk). `None` for
+    /// spheres, points and meshes. The one outline every technique that needs a polygon of
+    /// the light takes (DCS's wedges, the shadow maps' back-projection).
+    pub fn planar_outline(
+        &self,
+        disk_sides: u32,
+        disk_radius: impl Fn(f32) -> f32,
+    ) -> Option<Vec<Vec3>> {
+        match *self {
+            Self::Rectangle {
+                center: c,
+                half_u,
+                half_v,
+                ..
+            } => Some(vec![
+                c - half_u - half_v,
+                c + half_u - half_v,
+                c + half_u + half_v,
+                c - half_u + half_v,
+            ]),
+            Self::Polygon { outline, .. } => Some(outline.to_vec()),
+            Self::Disk {
+                center,
+                normal,
+                radius,
+            } => {
+                let (t1, t2) = crate::geometry::orthonormal_basis(normal);
+                let r = disk_radius(radius);
+                Some(
+                    (0..disk_sides)
+                        .map(|k| {
+                            let a = k as f32 * std::f32::consts::TAU / disk_sides as f32;
+                            center + (t1 * a.cos() + t2 * a.sin()) * r
+                        })
+                        .collect(),
+                )
+            }
+            Self::Sphere { .. } | Self::Point { .. } | Self::Mesh { .. } => None,
+        }
+    }
+
     /// The plane normal of planar lights, `None` for spheres, points and meshes.
     pub fn plane_normal(&self) -> Option<Vec3> {
         match *self {

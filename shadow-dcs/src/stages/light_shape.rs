@@ -100,48 +100,33 @@ impl LightShape {
             }
             _ => None,
         };
-        let (hull, exact) = match light.geometry() {
-            LightGeometry::Rectangle {
-                center: c,
-                half_u,
-                half_v,
-                ..
-            } => {
-                let v = vec![
-                    c - half_u - half_v,
-                    c + half_u - half_v,
-                    c + half_u + half_v,
-                    c - half_u + half_v,
-                ];
+        let geometry = light.geometry();
+        // The outline shared with the other techniques; a disk's polygon holds the disk.
+        let outline = || {
+            geometry
+                .planar_outline(DISK_SIDES as u32, |r| {
+                    r / (std::f32::consts::PI / DISK_SIDES as f32).cos() * 1.0001
+                })
+                .expect("a planar light has an outline")
+        };
+        let (hull, exact) = match geometry {
+            LightGeometry::Rectangle { .. } | LightGeometry::Polygon { .. } => {
+                let v = outline();
                 let e = Exact::Vertices(v.iter().map(|p| p.as_dvec3()).collect());
                 (v, e)
             }
-            LightGeometry::Polygon { outline, .. } => (
-                outline.to_vec(),
-                Exact::Vertices(outline.iter().map(|p| p.as_dvec3()).collect()),
-            ),
             LightGeometry::Disk {
                 center: c,
                 normal,
                 radius,
-            } => {
-                let (t1, t2) = shadow_core::geometry::orthonormal_basis(normal);
-                let r = radius / (std::f32::consts::PI / DISK_SIDES as f32).cos() * 1.0001;
-                let v = (0..DISK_SIDES)
-                    .map(|k| {
-                        let a = k as f32 * std::f32::consts::TAU / DISK_SIDES as f32;
-                        c + (t1 * a.cos() + t2 * a.sin()) * r
-                    })
-                    .collect();
-                (
-                    v,
-                    Exact::Disk {
-                        center: c.as_dvec3(),
-                        normal: normal.as_dvec3(),
-                        radius: radius as f64,
-                    },
-                )
-            }
+            } => (
+                outline(),
+                Exact::Disk {
+                    center: c.as_dvec3(),
+                    normal: normal.as_dvec3(),
+                    radius: radius as f64,
+                },
+            ),
             LightGeometry::Sphere { center: c, radius } => {
                 let r = radius * 1.0001;
                 let v = (0..8)
