@@ -42,6 +42,7 @@
 
 pub mod albedo;
 pub mod camera;
+pub mod corpus;
 pub mod direct;
 pub mod geometry;
 #[cfg(feature = "gpu")]

@@ -138,11 +138,15 @@ fn placed_obj(bytes: &[u8], size: f32, yaw: f32) -> Result<MeshDesc, BuiltinErro
     Ok(MeshDesc::new(positions, triangles).with_transform(t))
 }
 
-/// Builds a built-in scene by name.
+/// Builds a built-in scene, or a corpus scene of real meshes ([`crate::corpus`]), by name.
 ///
 /// # Errors
 /// [`BuiltinError::Unknown`] listing the valid names.
 pub fn builtin(name: &str) -> Result<SceneSetup, BuiltinError> {
+    // The corpus of real meshes (`crate::corpus`) answers to its own names.
+    if let Some(corpus) = crate::corpus::corpus_scene(name) {
+        return corpus.map_err(BuiltinError::from);
+    }
     if name == "spot-lamp" {
         let mut setup =
             crate::load::load_gltf_slice(SPOT_LAMP_GLTF, None, name, &LoadLimits::default())?;

@@ -41,6 +41,10 @@ pub struct BenchArgs {
     /// Presets (comma-separated; default all).
     #[arg(long, value_delimiter = ',')]
     techniques: Vec<String>,
+    /// Add every scene of the corpus of real meshes (`cargo xtask scenes` lists them) to the
+    /// time-error study.
+    #[arg(long)]
+    corpus: bool,
     /// Image width of the time-error study.
     #[arg(long, default_value_t = 128)]
     width: u32,
@@ -196,14 +200,18 @@ fn light_size_scene(side: f32) -> Result<SceneSetup, String> {
     Ok(s)
 }
 
-pub fn run(a: BenchArgs) -> Result<(), String> {
+pub fn run(mut a: BenchArgs) -> Result<(), String> {
     for s in &a.scenes {
-        if !BUILTIN_SCENES.contains(&s.as_str()) {
+        if !BUILTIN_SCENES.contains(&s.as_str()) && !shadow_core::corpus::is_corpus_scene(s) {
             return Err(format!(
-                "unknown scene `{s}`; valid names: {}",
+                "unknown scene `{s}`; valid names: {} and the corpus scenes `cargo xtask scenes` \
+                 lists",
                 BUILTIN_SCENES.join(", ")
             ));
         }
+    }
+    if a.corpus {
+        a.scenes.extend(shadow_core::corpus::corpus_scene_names());
     }
     for t in &a.techniques {
         shadow_conformance::preset(t)?;
@@ -702,12 +710,18 @@ fn write_summary(a: &BenchArgs, points: &[Point], truth_samples: u32) -> Result<
         })
         .collect();
     let heading = format!(
-        "`cargo xtask bench{}{} --scenes {} --repeats {}{}` ({}, {} threads, {}), {}x{} \
+        "`cargo xtask bench{}{}{} --scenes {} --repeats {}{}` ({}, {} threads, {}), {}x{} \
          pixels, errors against the reference at {truth_samples} samples with another seed, \
          medians of {} runs after a warm-up.",
         if a.quick { " --quick" } else { "" },
         if a.study_only { " --study-only" } else { "" },
-        a.scenes.join(","),
+        if a.corpus { " --corpus" } else { "" },
+        a.scenes
+            .iter()
+            .filter(|s| !(a.corpus && shadow_core::corpus::is_corpus_scene(s)))
+            .cloned()
+            .collect::<Vec<_>>()
+            .join(","),
         a.repeats,
         if a.techniques.is_empty() {
             String::new()

@@ -27,6 +27,9 @@ pub struct Measured<'a> {
     pub seconds: f64,
 }
 
+/// Scenes beyond which the Markdown table keeps the median and worst only (the CSV has all).
+const MAX_COLUMNS: usize = 16;
+
 /// Where the summary table goes in a docs page.
 pub const BEGIN: &str = "<!-- bench-summary:begin (cargo xtask bench --write-docs) -->";
 /// The end of that section.
@@ -116,33 +119,38 @@ pub fn tables(points: &[Measured], heading: &str) -> (String, String) {
          worst over the scenes each configuration runs on.\n"
     )
     .ok();
-    write!(md, "| configuration | median | worst | scenes |").ok();
-    for s in &scenes {
+    // One column per scene while the table stays readable; the CSV always has every scene.
+    let columns: &[String] = if scenes.len() <= MAX_COLUMNS {
+        &scenes
+    } else {
+        &[]
+    };
+    write!(md, "| configuration | median | worst | worst on | scenes |").ok();
+    for s in columns {
         write!(md, " {s} |").ok();
     }
-    write!(md, "\n|---|---|---|---|").ok();
-    for _ in &scenes {
+    write!(md, "\n|---|---|---|---|---|").ok();
+    for _ in columns {
         md.push_str("---|");
     }
     md.push('\n');
     let mut csv = String::from("configuration,scene,speedup,lower_bound\n");
     for (name, row) in &rows {
         let values: Vec<f64> = row.per_scene.values().map(|v| v.0).collect();
-        let worst = row
+        let (worst_on, worst) = row
             .per_scene
-            .values()
-            .copied()
-            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .iter()
+            .min_by(|a, b| a.1.0.total_cmp(&b.1.0))
             .expect("a row has a scene");
         write!(
             md,
-            "| {name} | {:.2}x | {} | {} |",
+            "| {name} | {:.2}x | {} | {worst_on} | {} |",
             median(values),
-            cell(worst),
+            cell(*worst),
             row.per_scene.len()
         )
         .ok();
-        for s in &scenes {
+        for s in columns {
             match row.per_scene.get(s) {
                 Some(v) => write!(md, " {} |", cell(*v)).ok(),
                 None => write!(md, " – |").ok(),
@@ -208,11 +216,11 @@ mod tests {
         ];
         let (md, csv) = tables(&points, "# run");
         assert!(
-            md.contains("| fast @ 4 | 5.25x | 0.50x | 2 | 10.00x | 0.50x |"),
+            md.contains("| fast @ 4 | 5.25x | 0.50x | b | 2 | 10.00x | 0.50x |"),
             "{md}"
         );
         assert!(
-            md.contains("| exact @ 4 | 2.00x | >2.00x | 1 | >2.00x | – |"),
+            md.contains("| exact @ 4 | 2.00x | >2.00x | a | 1 | >2.00x | – |"),
             "{md}"
         );
         assert!(csv.contains("fast @ 4,a,10.0000,false"), "{csv}");

@@ -19,7 +19,7 @@ pub fn resolve_scene(
     own_light: bool,
     emissive_as_geometry: bool,
 ) -> Result<SceneSetup, String> {
-    if BUILTIN_SCENES.contains(&name) {
+    if BUILTIN_SCENES.contains(&name) || shadow_core::corpus::is_corpus_scene(name) {
         if emissive_as_geometry {
             return Err(format!(
                 "--emissive-as-geometry applies to scene files; `{name}` is a built-in scene"
@@ -30,7 +30,8 @@ pub fn resolve_scene(
     let path = Path::new(name);
     if !path.exists() {
         return Err(format!(
-            "`{name}` is neither a built-in scene nor a file; built-in scenes: {}",
+            "`{name}` is neither a built-in scene, a corpus scene nor a file; built-in scenes: \
+             {} (corpus scenes: `cargo xtask scenes`)",
             BUILTIN_SCENES.join(", ")
         ));
     }
@@ -138,6 +139,15 @@ pub fn list_scenes() -> Result<(), String> {
     }
     println!(
         "\nScaled and translated variants are built by the stress suite (`cargo xtask stress`)."
+    );
+    println!(
+        "\nThe corpus of real meshes (`shadow_core::corpus`, {} scenes: each mesh at a largest \
+         extent of 1 m on a floor, under a tilted rectangle or a disk light of a quarter or the \
+         whole of that extent), by name in render and bench (`--corpus`): \
+         corpus-<mesh>-<light>\n  meshes: {}\n  lights: {}",
+        shadow_core::corpus::corpus_scene_names().len(),
+        shadow_core::corpus::CORPUS_MESHES.join(", "),
+        shadow_core::corpus::CORPUS_LIGHTS.join(", ")
     );
     Ok(())
 }
