@@ -1,10 +1,15 @@
 #!/usr/bin/env python3
 """Peer benchmark: Embree's single-ray occlusion query (through the `embreex` binding) on the
-exact rays the reference casts for the `bunny` scene.
+exact rays the reference casts for a scene (`bunny` by default).
 
     cargo xtask bench --export-rays          # writes out/bench/bunny-{rays,triangles}.bin
     pip install embreex numpy
     python3 scripts/embree_peer.py out/bench
+
+Any built-in or corpus scene, with the reference's own rates printed beside:
+
+    cargo run --release -p shadow-ref --example query_bench -- SCENE 160 120 /tmp/peer
+    python3 scripts/embree_peer.py /tmp/peer SCENE
 
 The rays are (origin, unit direction, length) in f32; Embree gets the length as `tfar`. The
 script prints rays per second on one thread (best of five) and the occluded share, to compare
@@ -21,8 +26,9 @@ from embreex.mesh_construction import TriangleMesh
 
 def main() -> None:
     d = sys.argv[1] if len(sys.argv) > 1 else "out/bench"
-    rays = np.fromfile(os.path.join(d, "bunny-rays.bin"), dtype="<f4").reshape(-1, 7)
-    tris = np.fromfile(os.path.join(d, "bunny-triangles.bin"), dtype="<f4").reshape(-1, 3, 3)
+    name = sys.argv[2] if len(sys.argv) > 2 else "bunny"
+    rays = np.fromfile(os.path.join(d, f"{name}-rays.bin"), dtype="<f4").reshape(-1, 7)
+    tris = np.fromfile(os.path.join(d, f"{name}-triangles.bin"), dtype="<f4").reshape(-1, 3, 3)
     scene = rtcs.EmbreeScene()
     TriangleMesh(scene, np.ascontiguousarray(tris))
     o = np.ascontiguousarray(rays[:, 0:3])

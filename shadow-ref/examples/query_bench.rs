@@ -1,6 +1,11 @@
 //! The single-ray occlusion query on the reference's own segments, both traversals:
 //!
-//!     cargo run --release -p shadow-ref --example query_bench -- [SCENE] [WIDTH] [HEIGHT]
+//!     cargo run --release -p shadow-ref --example query_bench -- [SCENE] [WIDTH] [HEIGHT] [DIR]
+//!
+//! SCENE is a built-in or corpus scene name. With DIR, the segments and the scene's triangles
+//! are also written there as `<SCENE>-rays.bin` and `<SCENE>-triangles.bin` (little-endian f32:
+//! origin, unit direction, length per ray; three corners per triangle) for
+//! `scripts/embree_peer.py DIR SCENE`, which answers the same segments with Embree.
 //!
 //! Prints rays per second on one thread for the reference's trace phase answering the segments
 //! (best of eight) and for the single-ray query alone on the wide tree and on the `obvhs`
@@ -25,6 +30,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let r = Reference::stratified(64, 1)?;
     let r_prepared = r.prepare_reference(setup.scene.clone(), setup.lights[0].clone())?;
     let segs = r_prepared.segments(&view);
+    if let Some(dir) = args.get(3) {
+        export(std::path::Path::new(dir), scene, &setup, &segs)?;
+    }
     // The reference's whole trace phase (sampling, offsets, beam culling, queries) answering
     // the same segments, on one thread.
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
@@ -67,4 +75,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         return Err("the two traversals disagree".into());
     }
     Ok(())
+}
+
+/// Writes the segments and the triangles for the Embree peer (see the module docs).
+fn export(
+    dir: &std::path::Path,
+    scene: &str,
+    setup: &shadow_core::load::SceneSetup,
+    segs: &[Segment],
+) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    let mut rays = Vec::with_capacity(segs.len() * 28);
+    for (o, d, t, _) in segs {
+        for v in o.to_array().into_iter().chain(d.to_array()).chain([*t]) {
+            rays.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    std::fs::write(dir.join(format!("{scene}-rays.bin")), rays)?;
+    let mut tris = Vec::new();
+    for t in 0..setup.scene.triangle_count() {
+        for p in setup.scene.triangle(t) {
+            for v in p.to_array() {
+                tris.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+    }
+    std::fs::write(dir.join(format!("{scene}-triangles.bin")), tris)
 }
