@@ -13,6 +13,8 @@ use std::path::Path;
 
 use shadow_conformance::conformance::{CurvePoint, reference_time_at};
 
+use crate::bench::median;
+
 /// One measured point of the study: scene, technique, samples, RMSE, seconds.
 pub struct Measured<'a> {
     /// Scene name.
@@ -78,18 +80,6 @@ fn speedups(points: &[Measured]) -> BTreeMap<String, Row> {
             .insert(p.scene.to_string(), (ratio, beyond));
     }
     rows
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n == 0 {
-        f64::NAN
-    } else if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
 }
 
 fn cell((ratio, beyond): (f64, bool)) -> String {

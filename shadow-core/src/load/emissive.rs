@@ -53,10 +53,7 @@ pub fn light_from_emissive_mesh(
         mesh: name.to_string(),
         reason: reason.to_string(),
     };
-    let light_err = |source: LightError| LoadError::Light {
-        mesh: name.to_string(),
-        source,
-    };
+    let light_err = light_error(name);
     if triangles.is_empty() {
         return Err(unsupported("emissive mesh has no triangles"));
     }
@@ -218,10 +215,7 @@ fn mesh_light(
     emission: Vec3,
     texture: Option<EmissiveTexture>,
 ) -> Result<Light, LoadError> {
-    let light_err = |source: LightError| LoadError::Light {
-        mesh: name.to_string(),
-        source,
-    };
+    let light_err = light_error(name);
     let tris: Vec<[Vec3; 3]> = triangles
         .iter()
         .map(|t| t.map(|v| positions[v as usize]))
@@ -258,6 +252,14 @@ fn mesh_light(
     }
     .map_err(light_err)?;
     Ok(Arc::new(light))
+}
+
+/// The error of an invalid light made from mesh `name`.
+fn light_error(name: &str) -> impl Fn(LightError) -> LoadError + Copy + '_ {
+    move |source| LoadError::Light {
+        mesh: name.to_string(),
+        source,
+    }
 }
 
 /// Directed boundary loops (edges used by exactly one triangle), following the winding.
