@@ -80,6 +80,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "pairs-one-sample",
         "texels-visited",
         "silhouette-edges",
+        "tiles-culled",
+        "texels-culled-by-depth",
+        "pairs-after-umbra",
+        "tiles-numbered",
     ] {
         println!("  {k} {}", est.stats.counter(k).unwrap_or(0));
     }

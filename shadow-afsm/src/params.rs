@@ -42,11 +42,11 @@ pub struct Params {
     pub kind: [u32; 4],
     /// LUT bins (theta, phi, delta), textured flag.
     pub lut: [u32; 4],
-    /// Occlusion work of one caster range: first caster, caster count, tiles, chunks.
+    /// Occlusion work of one caster range: first caster, caster count, tiles, pairs.
     pub work: [u32; 4],
     /// x = 1 when the silhouette stencil restricts per-sample work; y = 1 when semi-opaque
     /// casters accumulate per-sample optical depths; z = buckets per side of the sample grid
-    /// (0: none).
+    /// (0: none); w = 1 when cluster culling is on.
     pub options: [u32; 4],
     /// Sample grid origin (u, v) and buckets per unit (u, v) in the light's plane.
     pub grid: [f32; 4],

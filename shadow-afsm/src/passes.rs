@@ -4,10 +4,10 @@
 //! 2. `scan_block` / `scan_add`: the running sum of list lengths gives list offsets;
 //! 3. `scatter`: each view sample's index goes to its list's offset plus its slot;
 //! 4. per batch of caster triangles, `influence` (section 4.1); then, per range of casters,
-//!    `tiles` (8 x 8 texel tiles per region, numbered by a running sum), `tile_pairs` (pairs
-//!    per tile from the overlapping texels' lists, in chunks of 64, numbered by a running sum)
-//!    and `occlude` (sections 3.2, 3.3, 4.2, 4.3: one workgroup per chunk, one pair per
-//!    invocation);
+//!    `tiles` (the map's 8 x 8 texel tiles each region touches, numbered by a running sum),
+//!    `tile_pairs` (cluster culling of each (caster, tile), then the pairs of the overlapping
+//!    texels' lists, numbered by a running sum) and `occlude` (sections 3.2, 3.3, 4.2, 4.3: a
+//!    few consecutive pairs per invocation);
 //! 5. `resolve`: horizon test, visible bits, counts and radiance sums.
 //!
 //! Every invocation does bounded work, however large an influence region or long a list: the
@@ -186,6 +186,8 @@ pub struct Shared<'a> {
     pub silhouettes: &'a [CasterBatch],
     /// The largest buffer the technique may bind (the device's limit or a smaller cap).
     pub limit: u64,
+    /// Cluster culling (`tile_pairs.wgsl`) on.
+    pub culling: bool,
 }
 
 /// What a range of tiled regions is for.
@@ -197,11 +199,19 @@ enum Work<'a> {
     Stencil,
 }
 
-/// 64-bit tally slots beyond [`TALLIES`]: tiles and chunks of the current caster range.
+/// 64-bit tally slots beyond [`TALLIES`]: tiles and pairs of the current caster range.
 const TILE_SLOT: usize = 7;
-const CHUNK_SLOT: usize = 8;
-/// Tallies buffer length in u32 words (nine 64-bit slots).
-const TALLY_WORDS: usize = 18;
+const PAIR_SLOT: usize = 8;
+/// The tallies of work skipped, kept over every range: cluster culling's (`tile_pairs.wgsl`)
+/// and the pairs whose view sample was already hidden from every light sample (`occlude.wgsl`).
+const SKIPPED_SLOTS: [(usize, &str); 4] = [
+    (9, "tiles-culled"),
+    (10, "texels-culled-by-depth"),
+    (11, "pairs-after-umbra"),
+    (12, "tiles-empty"),
+];
+/// Tallies buffer length in u32 words (thirteen 64-bit slots).
+const TALLY_WORDS: usize = 26;
 
 /// The buffers one batch of view samples shares between its caster ranges.
 struct Occlusion<'a> {
@@ -216,9 +226,17 @@ struct Occlusion<'a> {
     tallies: &'a wgpu::Buffer,
     flags: &'a wgpu::Buffer,
     depths: &'a wgpu::Buffer,
+    tile_depth: &'a wgpu::Buffer,
+    texel_depth: &'a wgpu::Buffer,
+    tile_box: &'a wgpu::Buffer,
 }
 
 impl Occlusion<'_> {
+    /// Words of sample bits per view sample.
+    fn shared_words(&self, params: &Params) -> u32 {
+        params.dims[3].max(1)
+    }
+
     /// Reads the 64-bit tally `slot`.
     fn tally(&self, slot: usize) -> Result<u64, GpuError> {
         let t: Vec<u32> = self.gpu.read(self.tallies, TALLY_WORDS)?;
@@ -280,7 +298,7 @@ impl Occlusion<'_> {
         if tiles == 0 {
             return Ok(());
         }
-        // Three words per tile: its chunk count and its 64-bit overlap mask.
+        // Three words per tile: its pair count and its 64-bit overlap mask.
         let max_tiles = (self.shared.limit / 12)
             .saturating_sub(1)
             .min(u32::MAX as u64 / 3 - 1);
@@ -313,11 +331,14 @@ impl Occlusion<'_> {
                 });
             }
         };
-        // Chunk counts (scanned in place), then two words of overlap mask per tile.
-        let chunk_counts = gpu.storage_zeroed("chunk counts", (3 * tiles + 1) * 4)?;
-        let chunks = stats.time("gpu-tiles", || {
+        // Pair counts (scanned in place), then two words of overlap mask per tile. The tallies
+        // are kept aside in case the range must be split and its tiles counted again.
+        let pair_counts = gpu.storage_zeroed("pair counts", (3 * tiles + 1) * 4)?;
+        let saved = gpu.storage_zeroed("saved tallies", TALLY_WORDS as u64 * 4)?;
+        let pairs = stats.time("gpu-tiles", || {
             let uni = gpu.uniform("params", &p);
             let mut enc = gpu.encoder();
+            enc.copy_buffer_to_buffer(self.tallies, 0, &saved, 0, TALLY_WORDS as u64 * 4);
             let b = gpu.bind(
                 &pipes.tile_pairs,
                 &[
@@ -325,8 +346,12 @@ impl Occlusion<'_> {
                     self.regions,
                     &tile_counts,
                     self.offsets,
-                    &chunk_counts,
+                    &pair_counts,
                     self.tallies,
+                    &batch.buffer,
+                    self.tile_depth,
+                    self.texel_depth,
+                    self.tile_box,
                 ],
             );
             gpu.dispatch(&mut enc, &pipes.tile_pairs, &b, tiles.div_ceil(64))?;
@@ -334,24 +359,36 @@ impl Occlusion<'_> {
                 gpu,
                 pipes,
                 &mut enc,
-                &chunk_counts,
+                &pair_counts,
                 tiles as u32 + 1,
                 &mut keep,
             )?;
             gpu.submit(enc)?;
-            self.tally(CHUNK_SLOT)
+            self.tally(PAIR_SLOT)
         })?;
-        if chunks >= u32::MAX as u64 {
-            return Err(GpuError::TooLarge {
-                what: format!("occlusion work of {chunks} chunks of 64 pairs in one caster range"),
-                needed: chunks,
-                limit: u32::MAX as u64,
-            });
+        if pairs >= u32::MAX as u64 {
+            // The running sum of pair counts is 32-bit: count the halves apart.
+            let half = count / 2;
+            if half == 0 {
+                return Err(GpuError::TooLarge {
+                    what: format!("occlusion work of {pairs} pairs for one caster"),
+                    needed: pairs,
+                    limit: u32::MAX as u64 - 1,
+                });
+            }
+            let mut enc = gpu.encoder();
+            enc.copy_buffer_to_buffer(&saved, 0, self.tallies, 0, TALLY_WORDS as u64 * 4);
+            gpu.submit(enc)?;
+            self.range(params, work, base, half, stats)?;
+            return self.range(params, work, base + half, count - half, stats);
         }
-        if chunks == 0 {
+        if pairs == 0 {
             return Ok(());
         }
-        p.work[3] = chunks as u32;
+        p.work[3] = pairs as u32;
+        // Pairs per invocation as `pairs_per_invocation` in `occlude.wgsl` deals them.
+        let per_invocation = (64 / self.shared_words(&params)).clamp(1, 8) as u64;
+        let groups = pairs.div_ceil(64 * per_invocation);
         stats.time("gpu-occlude", || {
             let uni = gpu.uniform("params", &p);
             let mut enc = gpu.encoder();
@@ -362,7 +399,7 @@ impl Occlusion<'_> {
                     self.regions,
                     &tile_counts,
                     self.offsets,
-                    &chunk_counts,
+                    &pair_counts,
                     &batch.buffer,
                     self.receivers,
                     self.lists,
@@ -374,7 +411,7 @@ impl Occlusion<'_> {
                     self.depths,
                 ],
             );
-            gpu.dispatch(&mut enc, &pipes.occlude, &b, chunks)?;
+            gpu.dispatch(&mut enc, &pipes.occlude, &b, groups)?;
             gpu.submit(enc)
         })
     }
@@ -404,6 +441,8 @@ pub struct BatchOutput {
     pub regions: Vec<Region>,
     /// The occlusion tallies ([`TALLIES`]).
     pub tallies: [u64; TALLIES.len()],
+    /// The tallies of work skipped, named.
+    pub skipped: Vec<(&'static str, u64)>,
 }
 
 /// Runs every pass for one batch of receivers; `params` holds the frame, light and sizes
@@ -424,10 +463,12 @@ pub fn run_batch(
     params.dims[1] = n;
     params.options[0] = (!shared.silhouettes.is_empty()) as u32;
     params.options[1] = shared.semi_opaque as u32;
+    params.options[3] = shared.culling as u32;
     let side = params.dims[0];
     let words = params.dims[3];
     let texels = side * side;
     let mut keep = Vec::new();
+    let tiles_per_side = side.div_ceil(8) as u64;
     let (rbuf, counts, slots, lists, masks, result, tallies) = stats.time("gpu-upload", || {
         Ok::<_, GpuError>((
             gpu.storage("receivers", receivers)?,
@@ -439,11 +480,25 @@ pub fn run_batch(
             gpu.storage_zeroed("tallies", TALLY_WORDS as u64 * 4)?,
         ))
     })?;
+    let texel_depth = gpu.storage_zeroed("texel depths", texels as u64 * 4)?;
+    let tile_depth = gpu.storage_zeroed("tile depths", tiles_per_side * tiles_per_side * 4)?;
+    let tile_box = gpu.storage_zeroed("tile boxes", tiles_per_side * tiles_per_side * 24)?;
     let uni = gpu.uniform("params", &params);
     let groups = (n as u64).div_ceil(64);
     stats.time("gpu-lists", || {
         let mut enc = gpu.encoder();
-        let b = gpu.bind(&pipes.count, &[&uni, &rbuf, &counts, &slots]);
+        let b = gpu.bind(
+            &pipes.count,
+            &[
+                &uni,
+                &rbuf,
+                &counts,
+                &slots,
+                &texel_depth,
+                &tile_depth,
+                &tile_box,
+            ],
+        );
         gpu.dispatch(&mut enc, &pipes.count, &b, groups)?;
         scan(gpu, pipes, &mut enc, &counts, texels + 1, &mut keep)?;
         gpu.submit(enc)?;
@@ -482,6 +537,9 @@ pub fn run_batch(
         tallies: &tallies,
         flags: &flags,
         depths: &depths,
+        tile_depth: &tile_depth,
+        texel_depth: &texel_depth,
+        tile_box: &tile_box,
     };
     for batch in shared.silhouettes {
         occ.batch(params, batch, Work::Stencil, stats)?;
@@ -512,16 +570,19 @@ pub fn run_batch(
     })?;
     stats.time("gpu-readback", || {
         let t: Vec<u32> = gpu.read(&tallies, TALLY_WORDS)?;
+        let word = |k: usize| t[2 * k] as u64 | (t[2 * k + 1] as u64) << 32;
         let mut tallies = [0u64; TALLIES.len()];
         for (k, v) in tallies.iter_mut().enumerate() {
-            *v = t[2 * k] as u64 | (t[2 * k + 1] as u64) << 32;
+            *v = word(k);
         }
+        let skipped = SKIPPED_SLOTS.iter().map(|&(k, name)| (name, word(k))).collect();
         Ok(BatchOutput {
             result: gpu.read(&result, n as usize)?,
             visible: gpu.read(&masks, (n * words) as usize)?,
             offsets: gpu.read(&counts, texels as usize + 1)?,
             regions: last_regions,
             tallies,
+            skipped,
         })
     })
 }

@@ -97,6 +97,7 @@ pub struct Afsm {
     hard: bool,
     plane_test: PlaneTest,
     stencil: bool,
+    culling: bool,
     memory_limit: Option<u64>,
 }
 
@@ -199,6 +200,7 @@ impl Afsm {
             hard: false,
             plane_test: PlaneTest::Exact,
             stencil: false,
+            culling: true,
             memory_limit: None,
         })
     }
@@ -233,6 +235,14 @@ impl Afsm {
     /// default.
     pub fn with_silhouette_stencil(mut self) -> Self {
         self.stencil = true;
+        self
+    }
+
+    /// Turns cluster culling off (`tile_pairs.wgsl`): every view sample listed in a texel of a
+    /// caster's influence region is tested against it, as in the paper. The output is the
+    /// same sample for sample; only the work differs (tests compare the two).
+    pub fn without_cluster_culling(mut self) -> Self {
+        self.culling = false;
         self
     }
 
@@ -627,6 +637,7 @@ impl Afsm {
         let mut stages = Vec::new();
         let (mut occupied, mut longest, mut batches) = (0u64, 0u64, 0u64);
         let mut tallies = [0u64; TALLIES.len()];
+        let mut skipped: Vec<(&str, u64)> = Vec::new();
         let groups = stats.time("frame", || {
             group_receivers(p.bounds.center, &receivers, &pixels, per_batch, side)
         });
@@ -649,6 +660,7 @@ impl Afsm {
                 semi_opaque: p.semi_opaque,
                 silhouettes: &p.silhouettes,
                 limit,
+                culling: self.culling,
             };
             let out = run_batch(
                 &p.gpu,
@@ -667,6 +679,12 @@ impl Afsm {
             }
             for (k, t) in out.tallies.iter().enumerate() {
                 tallies[k] = tallies[k].saturating_add(*t);
+            }
+            for &(name, v) in &out.skipped {
+                match skipped.iter_mut().find(|(n, _)| *n == name) {
+                    Some((_, total)) => *total = total.saturating_add(v),
+                    None => skipped.push((name, v)),
+                }
             }
             for (j, &i) in chunk_px.iter().enumerate() {
                 let [r, g, b, count] = out.result[j];
@@ -716,6 +734,9 @@ impl Afsm {
         for (k, name) in TALLIES.iter().enumerate() {
             stats.add(name, tallies[k]);
         }
+        for (name, v) in skipped {
+            stats.add(name, v);
+        }
         Ok((Estimate::new(vis, stats), receivers, stages))
     }
 }
@@ -745,6 +766,7 @@ impl ShadowTechnique for Afsm {
             "hard": self.hard,
             "plane_test": format!("{:?}", self.plane_test),
             "silhouette_stencil": self.stencil && !self.hard && self.samples > 1,
+            "cluster_culling": self.culling,
             "lut_bins": (self.plane_test == PlaneTest::Lut).then(|| crate::lut::bins_for(self.samples)),
         })
     }

@@ -21,11 +21,11 @@ struct Params {
     kind: vec4<u32>,
     // LUT bins in theta, phi, delta; 1 when the light is textured.
     lut: vec4<u32>,
-    // The occlusion work of one range of casters: first caster, caster count, tiles, chunks.
+    // The occlusion work of one range of casters: first caster, caster count, tiles, pairs.
     work: vec4<u32>,
     // x = 1 when the silhouette stencil restricts per-sample work (section 4.3); y = 1 when
     // semi-opaque casters accumulate per-sample optical depths; z = buckets per side of the
-    // sample grid (0: none).
+    // sample grid (0: none); w = 1 when cluster culling is on.
     options: vec4<u32>,
     // The sample grid: origin (u, v) and buckets per unit (u, v) in the light's plane.
     grid: vec4<f32>,
@@ -119,13 +119,82 @@ fn light_range(m: vec3<f32>) -> vec2<f32> {
     }
 }
 
-// Influence regions are covered by tiles of TILE x TILE texels (one workgroup's worth).
+// Influence regions are covered by tiles of TILE x TILE texels (one workgroup's worth), on a
+// grid fixed to the map so that a tile is also a cluster of view samples with its own bounds.
 const TILE: i32 = 8;
 
-// Tiles across and down a texel box (zero for an empty box).
+// A float's bits reordered so that unsigned order is the float order (atomicMax then keeps
+// the largest float; of the complement, the smallest), and back. 0 is no float's key.
+fn order_key(f: f32) -> u32 {
+    let b = bitcast<u32>(f);
+    return select(b | 0x80000000u, ~b, (b & 0x80000000u) != 0u);
+}
+
+fn from_key(k: u32) -> f32 {
+    return bitcast<f32>(select(~k, k & 0x7fffffffu, (k & 0x80000000u) != 0u));
+}
+
+// Tiles across the map's side.
+fn tiles_per_side() -> u32 {
+    return (P.dims.x + u32(TILE) - 1u) / u32(TILE);
+}
+
+// Tiles across and down a texel box (zero for an empty box): the map's tiles it touches.
 fn tiles_across(bbox: vec4<i32>) -> vec2<u32> {
     if bbox.z < bbox.x || bbox.w < bbox.y {
         return vec2<u32>(0u);
     }
-    return vec2<u32>(u32((bbox.z - bbox.x) / TILE + 1), u32((bbox.w - bbox.y) / TILE + 1));
+    return vec2<u32>(u32(bbox.z / TILE - bbox.x / TILE + 1), u32(bbox.w / TILE - bbox.y / TILE + 1));
+}
+
+// Up to 8 points whose convex hull holds the part of the light that can be seen through a
+// point `vk` (section 4.1): the polygon's outline, the octagon around a disk, or the regular
+// hexagon around a sphere's silhouette circle seen from `vk`; none for a point light. Returns
+// how many, or -1 when `vk` lies inside the sphere (no bound).
+fn light_points(vk: vec3<f32>, ys: ptr<function, array<vec3<f32>, 8>>) -> i32 {
+    let c = P.center.xyz;
+    switch P.kind.y {
+        case 1u: {
+            let rad = P.light_n.w / cos(3.14159265 / 8.0);
+            for (var j = 0u; j < 8u; j++) {
+                let a = f32(j) * 3.14159265 / 4.0;
+                (*ys)[j] = c + rad * (cos(a) * P.light_u.xyz + sin(a) * P.light_v.xyz);
+            }
+            return 8;
+        }
+        case 2u: {
+            // Silhouette circle of the sphere seen from vk (centre, radius, plane), and the
+            // regular hexagon around it.
+            let rs = P.light_n.w;
+            let w = vk - c;
+            let l2 = dot(w, w);
+            if l2 <= rs * rs * 1.0001 {
+                return -1;
+            }
+            let axis = w / sqrt(l2);
+            let mid = c + (rs * rs / l2) * w;
+            let rho = rs * sqrt(max(1.0 - rs * rs / l2, 0.0));
+            var e1 = cross(axis, vec3<f32>(0.0, 1.0, 0.0));
+            if dot(e1, e1) < 1e-6 {
+                e1 = cross(axis, vec3<f32>(1.0, 0.0, 0.0));
+            }
+            e1 = normalize(e1);
+            let e2 = cross(axis, e1);
+            let rad = rho / cos(3.14159265 / 6.0);
+            for (var j = 0u; j < 6u; j++) {
+                let a = f32(j) * 3.14159265 / 3.0;
+                (*ys)[j] = mid + rad * (cos(a) * e1 + sin(a) * e2);
+            }
+            return 6;
+        }
+        case 3u: {
+            return 0;
+        }
+        default: {
+            for (var j = 0u; j < P.kind.z; j++) {
+                (*ys)[j] = P.outline[j].xyz;
+            }
+            return i32(P.kind.z);
+        }
+    }
 }

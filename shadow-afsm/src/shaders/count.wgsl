@@ -1,10 +1,17 @@
 // Section 3.1, construction: each listed view sample is projected into the shadow map and
-// takes the next slot of its texel's list with an atomic increment.
+// takes the next slot of its texel's list with an atomic increment. Each texel and each tile
+// of the map (a cluster of view samples) also keeps its farthest view sample's depth, the
+// bound that cluster culling tests casters against (`tile_pairs.wgsl`), and each tile the box
+// of its view samples' ray origins (six keys: the complements of the smallest x, y, z, then the
+// largest); 0 marks none.
 
 @group(0) @binding(0) var<uniform> P: Params;
 @group(0) @binding(1) var<storage, read> receivers: array<Receiver>;
 @group(0) @binding(2) var<storage, read_write> counts: array<atomic<u32>>;
 @group(0) @binding(3) var<storage, read_write> slots: array<vec2<u32>>;
+@group(0) @binding(4) var<storage, read_write> texel_depth: array<atomic<u32>>;
+@group(0) @binding(5) var<storage, read_write> tile_depth: array<atomic<u32>>;
+@group(0) @binding(6) var<storage, read_write> tile_box: array<atomic<u32>>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n: vec3<u32>) {
@@ -13,10 +20,21 @@ fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n:
         return;
     }
     let side = P.dims.x;
-    let t = to_texel(project(receivers[i].origin).xy);
+    let q = project(receivers[i].origin);
+    let t = to_texel(q.xy);
     let tx = u32(clamp(floor(t.x), 0.0, f32(side - 1u)));
     let ty = u32(clamp(floor(t.y), 0.0, f32(side - 1u)));
     let texel = ty * side + tx;
     let local = atomicAdd(&counts[texel], 1u);
     slots[i] = vec2<u32>(texel, local);
+    // Positive floats order as their bits; the floor keeps a listed sample's bound above 0.
+    let z = bitcast<u32>(max(q.z, 1e-30));
+    atomicMax(&texel_depth[texel], z);
+    let tile = (ty / u32(TILE)) * tiles_per_side() + tx / u32(TILE);
+    atomicMax(&tile_depth[tile], z);
+    let o = receivers[i].origin;
+    for (var k = 0u; k < 3u; k++) {
+        atomicMax(&tile_box[6u * tile + k], ~order_key(o[k]));
+        atomicMax(&tile_box[6u * tile + 3u + k], order_key(o[k]));
+    }
 }

@@ -136,51 +136,12 @@ fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n:
         pts[k] = to_texel(project(vk).xy);
         // The points bounding the light as seen through this vertex.
         var ys: array<vec3<f32>, 8>;
-        switch P.kind.y {
-            case 1u: {
-                let rad = P.light_n.w / cos(3.14159265 / 8.0);
-                for (var j = 0u; j < 8u; j++) {
-                    let a = f32(j) * 3.14159265 / 4.0;
-                    ys[j] = c + rad * (cos(a) * P.light_u.xyz + sin(a) * P.light_v.xyz);
-                }
-                ny = 8u;
-            }
-            case 2u: {
-                // Silhouette circle of the sphere seen from vk (centre, radius, plane), and the
-                // regular hexagon around it (section 4.1).
-                let rs = P.light_n.w;
-                let w = vk - c;
-                let l2 = dot(w, w);
-                if l2 <= rs * rs * 1.0001 {
-                    whole_map(t);
-                    return;
-                }
-                let axis = w / sqrt(l2);
-                let mid = c + (rs * rs / l2) * w;
-                let rho = rs * sqrt(max(1.0 - rs * rs / l2, 0.0));
-                var e1 = cross(axis, vec3<f32>(0.0, 1.0, 0.0));
-                if dot(e1, e1) < 1e-6 {
-                    e1 = cross(axis, vec3<f32>(1.0, 0.0, 0.0));
-                }
-                e1 = normalize(e1);
-                let e2 = cross(axis, e1);
-                let rad = rho / cos(3.14159265 / 6.0);
-                for (var j = 0u; j < 6u; j++) {
-                    let a = f32(j) * 3.14159265 / 3.0;
-                    ys[j] = mid + rad * (cos(a) * e1 + sin(a) * e2);
-                }
-                ny = 6u;
-            }
-            case 3u: {
-                ny = 0u;
-            }
-            default: {
-                for (var j = 0u; j < P.kind.z; j++) {
-                    ys[j] = P.outline[j].xyz;
-                }
-                ny = P.kind.z;
-            }
+        let found = light_points(vk, &ys);
+        if found < 0 {
+            whole_map(t);
+            return;
         }
+        ny = u32(found);
         for (var j = 0u; j < ny; j++) {
             let zy = dot(ys[j] - c, d);
             if zv - zy <= 1e-6 * zfar {

@@ -1,7 +1,10 @@
-// Sections 3.2, 3.3 and 4.2: one workgroup per chunk of 64 (caster, view sample) pairs of one
-// tile (see `tiling.wgsl`): the tile's texels that overlap the caster's influence region
-// (conservative rasterisation) give their list lengths, a workgroup prefix sum finds each
-// invocation's pair, and every invocation tests its listed view sample against the triangle.
+// Sections 3.2, 3.3 and 4.2: the (caster, view sample) pairs of a range of casters, numbered
+// across tiles by the running sum of each tile's pair count (`tile_pairs.wgsl`), are dealt out
+// `pairs_per_invocation()` consecutive ones to each invocation: every invocation finds its
+// first pair's tile by a binary search, walks the tile's overlapping texels (their mask comes
+// from `tile_pairs`) to the pair's list entry, then steps through its pairs, searching again
+// when it passes the end of a tile. Lanes are never idle for want of pairs in a tile, and no
+// invocation's work grows with a region's size or a list's length.
 //
 // A light sample y is hidden from view sample o by the triangle when y lies inside the three
 // planes through o and each edge, and beyond the triangle's supporting plane. For closed
@@ -22,7 +25,7 @@
 // depth to each hidden sample's sum (saturating).
 
 @group(0) @binding(0) var<uniform> P: Params;
-@group(0) @binding(4) var<storage, read> chunk_offsets: array<u32>;
+@group(0) @binding(4) var<storage, read> pair_offsets: array<u32>;
 @group(0) @binding(5) var<storage, read> casters: array<Caster>;
 @group(0) @binding(6) var<storage, read> receivers: array<Receiver>;
 @group(0) @binding(7) var<storage, read> lists: array<u32>;
@@ -35,11 +38,8 @@
 @group(0) @binding(12) var<storage, read> flags: array<u32>;
 @group(0) @binding(13) var<storage, read_write> depths: array<atomic<u32>>;
 
-// The tile's list lengths (then their inclusive running sum), texel indices, and the pair
-// outcomes of the workgroup.
-var<workgroup> prefix: array<u32, 64>;
-var<workgroup> texels: array<u32, 64>;
-var<workgroup> outcomes: array<atomic<u32>, 5>;
+// The pair outcomes of the workgroup.
+var<workgroup> outcomes: array<atomic<u32>, 6>;
 
 // LUT cell of the oriented plane {y : dot(m, y - base) >= 0}.
 fn lut_cell(m: vec3<f32>, base: vec3<f32>) -> u32 {
@@ -99,10 +99,26 @@ fn hide_all(i: u32, depth: u32) {
     }
 }
 
+// Whether every light sample of receiver i is already hidden by an opaque caster: later
+// casters cannot change its answer (the mask only gains bits, and a hidden sample's optical
+// depth is never read).
+fn hidden_everywhere(i: u32) -> bool {
+    let n_samples = P.dims.z;
+    for (var wd = 0u; wd < P.dims.w; wd++) {
+        let rest = n_samples - wd * 32u;
+        let full = select((1u << rest) - 1u, 0xffffffffu, rest >= 32u);
+        if atomicLoad(&masks[i * P.dims.w + wd]) != full {
+            return false;
+        }
+    }
+    return true;
+}
+
 // Tests receiver `i` against caster `t` and ORs the occluded samples into its mask; `one`
 // when the receiver's texel is off the silhouette stencil (one sample stands for all). Returns
 // 0 for the receiver's own triangle, 1 for an empty pair, 2 for a full one, 3 for per-sample
-// work, 4 for a one-sample test.
+// work, 4 for a one-sample test, 5 for a receiver already hidden everywhere (its per-sample
+// work skipped; how many depends on the order pairs run in).
 fn occlude_pair(t: u32, i: u32, one: bool) -> u32 {
     let tri = casters[t];
     let a = tri.a;
@@ -111,6 +127,9 @@ fn occlude_pair(t: u32, i: u32, one: bool) -> u32 {
     let r = receivers[i];
     if r.triangle == tri.id {
         return 0u;
+    }
+    if hidden_everywhere(i) {
+        return 5u;
     }
     let nt = cross(b - a, c - a);
     let o = r.origin;
@@ -265,65 +284,99 @@ fn occlude_pair(t: u32, i: u32, one: bool) -> u32 {
     return 3u;
 }
 
-@compute @workgroup_size(64)
-fn main(@builtin(local_invocation_index) li: u32, @builtin(workgroup_id) w: vec3<u32>,
-        @builtin(num_workgroups) nw: vec3<u32>) {
-    let c = w.y * nw.x + w.x;
-    if c >= P.work.w {
-        return;
-    }
-    // The chunk's tile: the last tile whose first chunk is at or before c.
+// Consecutive pairs per invocation: enough to pay for the searches, few enough that the
+// per-sample loops of one invocation stay well inside software rasterisers' iteration limits.
+fn pairs_per_invocation() -> u32 {
+    return clamp(64u / P.dims.w, 1u, 8u);
+}
+
+// A position in the pair numbering: the tile, its texel mask not yet walked past, the current
+// texel's index and list length, the entry in that list, and the pair number where the tile
+// ends.
+struct Cursor {
+    tile: Tile,
+    slot: u32,
+    mask: vec2<u32>,
+    texel: u32,
+    len: u32,
+    entry: u32,
+    end: u32,
+}
+
+// Moves the cursor to the next overlapping texel of its tile (its mask must not be empty).
+fn next_texel(cur: ptr<function, Cursor>) {
+    let word = select(1u, 0u, (*cur).mask.x != 0u);
+    let k = 32u * word + firstTrailingBit((*cur).mask[word]);
+    (*cur).mask[word] &= (*cur).mask[word] - 1u;
+    (*cur).texel = tile_texel_index((*cur).tile, k);
+    (*cur).len = offsets[(*cur).texel + 1u] - offsets[(*cur).texel];
+    (*cur).entry = 0u;
+}
+
+// The cursor at pair `e` of the range.
+fn seek(e: u32) -> Cursor {
     var lo = 0u;
     var hi = P.work.z;
     while hi - lo > 1u {
         let mid = (lo + hi) / 2u;
-        if chunk_offsets[mid] <= c {
+        if pair_offsets[mid] <= e {
             lo = mid;
         } else {
             hi = mid;
         }
     }
-    let tl = tile_of(lo);
-    // The tile's overlap mask (from `tile_pairs`): texels off the hull or with empty lists are 0.
-    let bit = (chunk_offsets[P.work.z + 1u + 2u * lo + li / 32u] >> (li % 32u)) & 1u;
-    let texel = tile_texel_index(tl, li);
-    var len = 0u;
-    if bit == 1u {
-        len = offsets[texel + 1u] - offsets[texel];
+    var cur: Cursor;
+    cur.tile = tile_of(lo);
+    cur.slot = lo;
+    cur.mask = vec2<u32>(pair_offsets[P.work.z + 1u + 2u * lo],
+                         pair_offsets[P.work.z + 2u + 2u * lo]);
+    cur.end = pair_offsets[lo + 1u];
+    var local = e - pair_offsets[lo];
+    // At most 64 texels: the entry lies in the first texel whose list outlasts `local`.
+    next_texel(&cur);
+    for (var k = 0u; k < 64u && local >= cur.len; k++) {
+        local -= cur.len;
+        next_texel(&cur);
     }
-    texels[li] = texel;
-    prefix[li] = len;
-    workgroupBarrier();
-    for (var s = 1u; s < 64u; s <<= 1u) {
-        let add = select(0u, prefix[li - s], li >= s);
-        workgroupBarrier();
-        prefix[li] += add;
-        workgroupBarrier();
-    }
-    // This invocation's pair: entry e of the tile, in texel k's list.
-    let e = (c - chunk_offsets[lo]) * 64u + li;
-    if e < prefix[63] {
-        var k = 0u;
-        var step = 32u;
-        while step > 0u {
-            if prefix[k + step - 1u] <= e {
-                k += step;
+    cur.entry = local;
+    return cur;
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n: vec3<u32>,
+        @builtin(local_invocation_index) li: u32) {
+    let per = pairs_per_invocation();
+    let first = linear_index(g, n) * per;
+    var counts = array<u32, 6>(0u, 0u, 0u, 0u, 0u, 0u);
+    if first < P.work.w {
+        let last = min(first + per, P.work.w);
+        var cur = seek(first);
+        for (var e = first; e < last; e++) {
+            if e == cur.end {
+                cur = seek(e);
+            } else if cur.entry == cur.len {
+                next_texel(&cur);
             }
-            step >>= 1u;
+            let i = lists[offsets[cur.texel] + cur.entry];
+            cur.entry++;
+            let one = P.options.x == 1u && flags[cur.texel] == 0u;
+            counts[occlude_pair(cur.tile.caster, i, one)]++;
         }
-        let before = select(0u, prefix[max(k, 1u) - 1u], k > 0u);
-        let i = lists[offsets[texels[k]] + e - before];
-        let one = P.options.x == 1u && flags[texels[k]] == 0u;
-        atomicAdd(&outcomes[occlude_pair(tl.caster, i, one)], 1u);
+    }
+    for (var k = 0u; k < 6u; k++) {
+        if counts[k] != 0u {
+            atomicAdd(&outcomes[k], counts[k]);
+        }
     }
     workgroupBarrier();
-    // Tallies by outcome (empty, full, per-sample, own triangle, one sample), once per
-    // workgroup.
+    // Tallies by outcome (empty, full, per-sample, own triangle, one sample, already hidden),
+    // once per workgroup.
     if li == 0u {
         add64(2u, atomicLoad(&outcomes[1]));
         add64(3u, atomicLoad(&outcomes[2]));
         add64(4u, atomicLoad(&outcomes[3]));
         add64(5u, atomicLoad(&outcomes[0]));
         add64(6u, atomicLoad(&outcomes[4]));
+        add64(11u, atomicLoad(&outcomes[5]));
     }
 }

@@ -1,8 +1,8 @@
 // Load balancing of the occlusion work (section 4.3's restricted computations, spread evenly):
-// each caster's influence region is covered by 8 x 8 texel tiles, tiles hold the pairs of the
-// listed view samples in their texels that overlap the region, and chunks of 64 pairs are the
-// unit of work. Every invocation thus does a bounded amount of work however large a region or
-// long a list is. (Software rasterisers such as llvmpipe also end every loop of an invocation
+// each caster's influence region is covered by the map's 8 x 8 texel tiles it touches, tiles
+// hold the pairs of the listed view samples in their texels that overlap the region, and a few
+// consecutive pairs of the range's numbering are the unit of work. Every invocation thus does a
+// bounded amount of work however large a region or long a list is. (Software rasterisers such as llvmpipe also end every loop of an invocation
 // after 65535 iterations in all, so unbounded per-invocation loops would silently drop work.)
 //
 // Tiles are numbered per range of casters by the running sum of their counts (`tile_offsets`).
@@ -14,8 +14,11 @@
 struct Tile {
     // Caster index in the batch.
     caster: u32,
-    // First texel of the tile, and the last texel of the region's box.
+    // The map's tile (a cluster of view samples): its index and first texel.
+    index: u32,
     origin: vec2<i32>,
+    // The first and the last texel of the region's box.
+    first: vec2<i32>,
     last: vec2<i32>,
 }
 
@@ -35,8 +38,9 @@ fn tile_of(u: u32) -> Tile {
     let bbox = regions[t].bbox;
     let across = tiles_across(bbox).x;
     let j = u - tile_offsets[lo];
-    let origin = bbox.xy + TILE * vec2<i32>(i32(j % across), i32(j / across));
-    return Tile(t, origin, bbox.zw);
+    let cell = bbox.xy / TILE + vec2<i32>(i32(j % across), i32(j / across));
+    let index = u32(cell.y) * tiles_per_side() + u32(cell.x);
+    return Tile(t, index, TILE * cell, bbox.xy, bbox.zw);
 }
 
 // Conservative rasterisation (section 3.2): texel (tx, ty) overlaps the hull of caster t.
@@ -63,8 +67,8 @@ fn texel_overlaps(t: u32, tx: i32, ty: i32) -> bool {
     return inside;
 }
 
-// The map index of texel `k` (0..64, row-major) of a tile (past the map's edge when the tile
-// overhangs the region's box).
+// The map index of texel `k` (0..64, row-major) of a tile (outside the region's box, or past
+// the map's edge, when the tile overhangs the box).
 fn tile_texel_index(tl: Tile, k: u32) -> u32 {
     let tx = tl.origin.x + i32(k % u32(TILE));
     let ty = tl.origin.y + i32(k / u32(TILE));
@@ -76,7 +80,7 @@ fn tile_texel_index(tl: Tile, k: u32) -> u32 {
 fn tile_texel(tl: Tile, k: u32) -> vec2<u32> {
     let tx = tl.origin.x + i32(k % u32(TILE));
     let ty = tl.origin.y + i32(k / u32(TILE));
-    if tx > tl.last.x || ty > tl.last.y {
+    if tx < tl.first.x || ty < tl.first.y || tx > tl.last.x || ty > tl.last.y {
         return vec2<u32>(0u);
     }
     let texel = tile_texel_index(tl, k);

@@ -1,0 +1,67 @@
+//! Cluster culling (`tile_pairs.wgsl`) is conservative: with it and without it AFSM gives the
+//! same bit for every (view sample, light sample) pair, on scenes that exercise each of its
+//! tests (a room around the light for the supporting-plane test, a mesh on a floor for the
+//! depth and region tests, a sphere light whose far side lies beyond some view samples, a
+//! disk light, semi-opaque casters), while testing fewer pairs.
+
+use std::sync::Arc;
+
+use shadow_afsm::Afsm;
+use shadow_core::gpu::context_for_test;
+use shadow_core::metrics::compare;
+use shadow_core::prelude::*;
+use shadow_core::scenes::builtin;
+
+#[test]
+fn cluster_culling_changes_no_bit_and_tests_fewer_pairs() {
+    if context_for_test("cluster_culling_changes_no_bit_and_tests_fewer_pairs").is_none() {
+        return;
+    }
+    let mut fewer_somewhere = false;
+    for name in [
+        "cornell-box",
+        "bunny",
+        "sphere-light",
+        "contact",
+        "semi-opaque",
+        "large-light-close",
+    ] {
+        let setup = builtin(name).unwrap();
+        let view =
+            ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 64, 48).unwrap();
+        let run = |culling: bool| {
+            let mut a = Afsm::new(64, SamplingStrategy::Interleaved { tile: 2 }, 3).unwrap();
+            if !culling {
+                a = a.without_cluster_culling();
+            }
+            a.prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
+                .unwrap()
+                .estimate(&view, Outputs::VISIBILITY)
+                .unwrap()
+        };
+        let (culled, plain) = (run(true), run(false));
+        let m = compare(&culled.visibility, &plain.visibility).unwrap();
+        let count = |e: &Estimate, k: &str| e.stats.counter(k).expect("AFSM counts it");
+        println!(
+            "{name:<18} pairs tested {} -> {}, tiles culled {}, texels culled by depth {}, \
+             agreement {:.7}",
+            count(&plain, "pairs-tested"),
+            count(&culled, "pairs-tested"),
+            count(&culled, "tiles-culled"),
+            count(&culled, "texels-culled-by-depth"),
+            m.sample_agreement.unwrap()
+        );
+        assert_eq!(m.sample_agreement, Some(1.0), "{name}: {m:?}");
+        assert_eq!(m.max_abs, 0.0, "{name}");
+        assert_eq!(count(&plain, "tiles-culled"), 0, "{name}");
+        assert!(
+            count(&culled, "pairs-tested") <= count(&plain, "pairs-tested"),
+            "{name}"
+        );
+        fewer_somewhere |= count(&culled, "pairs-tested") * 2 < count(&plain, "pairs-tested");
+    }
+    assert!(
+        fewer_somewhere,
+        "culling should at least halve the pairs on one of these scenes"
+    );
+}
