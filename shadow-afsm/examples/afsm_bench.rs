@@ -1,8 +1,11 @@
 //! Time against error of AFSM beside the reference on the same samples, per-phase GPU times
 //! and the list statistics of the paper's Fig. 9 inlay, on the adapter the environment selects:
 //! `cargo run --release -p shadow-afsm --example afsm_bench -- [scene] [width] [height] [N]
-//! [exact|lut|stencil]`: exact plane tests on 4x4 interleaved sets (default), the plane lookup
-//! table of section 4.2 (one correlated set), or exact tests with the silhouette stencil.
+//! [exact|unculled|lut|stencil]`: exact plane tests on 4x4 interleaved sets (default), the same
+//! without cluster culling, the plane lookup table of section 4.2 (one correlated set), or
+//! exact tests with the silhouette stencil. The last line is a markdown table row (scene, AFSM
+//! s, reference s, AFSM / reference, pairs tested, share of them empty, tiles culled, pairs
+//! skipped after umbra) for `scripts/afsm_table.sh`.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -25,9 +28,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let interleaved = SamplingStrategy::Interleaved { tile: 4 };
     let afsm = match mode {
         "exact" => Afsm::new(n, interleaved, 1)?,
+        "unculled" => Afsm::new(n, interleaved, 1)?.without_cluster_culling(),
         "stencil" => Afsm::new(n, interleaved, 1)?.with_silhouette_stencil(),
         "lut" => Afsm::new(n, SamplingStrategy::Correlated, 1)?.with_lut()?,
-        other => return Err(format!("unknown mode `{other}`: exact, lut or stencil").into()),
+        other => {
+            return Err(format!("unknown mode `{other}`: exact, unculled, lut or stencil").into());
+        }
     };
     let afsm_prepared = afsm.prepare_afsm(setup.scene.clone(), Arc::clone(&light))?;
     afsm_prepared.estimate(&view, Outputs::VISIBILITY)?; // warm-up
@@ -60,7 +66,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         m.rmse
     );
     for p in &est.stats.phases {
-        println!("  phase {:<16} {:.4} s", p.name, p.seconds);
+        let device = est.stats.counter(&format!("{}-device-ns", p.name));
+        match device {
+            Some(ns) => println!(
+                "  phase {:<16} {:.4} s (device {:.4} s by timestamp queries)",
+                p.name,
+                p.seconds,
+                ns as f64 * 1e-9
+            ),
+            None => println!("  phase {:<16} {:.4} s", p.name, p.seconds),
+        }
     }
     let occupied = est.stats.counter("lists-occupied").unwrap();
     let listed = est.stats.counter("receivers-listed").unwrap();
@@ -87,5 +102,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     ] {
         println!("  {k} {}", est.stats.counter(k).unwrap_or(0));
     }
+    let count = |k: &str| est.stats.counter(k).unwrap_or(0);
+    println!(
+        "| {scene} | {t_afsm:.3} | {t_ref:.3} | {:.1} | {} | {:.0}% | {} | {} |",
+        t_afsm / t_ref,
+        count("pairs-tested"),
+        100.0 * count("pairs-empty") as f64 / count("pairs-tested").max(1) as f64,
+        count("tiles-culled"),
+        count("pairs-after-umbra"),
+    );
     Ok(())
 }

@@ -1,10 +1,13 @@
-//! What the passes take besides the scene's triangles: view samples grouped into receiver
-//! batches with their fitted frusta (section 4.3), and the edges that can be a silhouette for
-//! some point of the light as degenerate casters for the stencil (section 4.3).
+//! What the passes take: the scene's triangles as casters in device buffers, view samples
+//! grouped into receiver batches with their fitted frusta (section 4.3), and the edges that can
+//! be a silhouette for some point of the light as degenerate casters for the stencil (section
+//! 4.3).
 
 use crate::frame::MapFrame;
 use crate::params::{Caster, LightBounds, Receiver};
+use crate::passes::{CasterBatch, device_error};
 use glam::Vec3;
+use shadow_core::gpu::{GpuContext, GpuError};
 use shadow_core::prelude::*;
 
 /// Receivers in batches of at most `per_batch`, each with its fitted frustum. When one
@@ -120,4 +123,37 @@ pub(crate) fn closed_meshes_between(
         .zip(around_light)
         .filter(|(eye_in, light_in)| eye_in != light_in)
         .count()
+}
+
+/// The casters of `scene`: every triangle that hides anything (fully transparent ones are
+/// left out), flagged closed when its component is in `closed`.
+pub(crate) fn casters_of(scene: &dyn Scene, closed: &[bool]) -> Vec<Caster> {
+    let topo = scene.topology();
+    let opacities = scene.opacities();
+    (0..scene.triangle_count())
+        .filter(|&t| opacities[t] > 0.0)
+        .map(|t| {
+            Caster::new(scene.triangle(t), t as u32, closed[topo.component_of(t)])
+                .with_opacity(opacities[t])
+        })
+        .collect()
+}
+
+/// `casters` in buffers of at most `per` casters each.
+pub(crate) fn upload_casters(
+    gpu: &GpuContext,
+    casters: &[Caster],
+    per: usize,
+    label: &str,
+) -> Result<Vec<CasterBatch>, TechniqueError> {
+    casters
+        .chunks(per)
+        .map(|c| {
+            Ok(CasterBatch {
+                buffer: gpu.storage(label, c)?,
+                len: c.len() as u32,
+            })
+        })
+        .collect::<Result<Vec<_>, GpuError>>()
+        .map_err(device_error)
 }

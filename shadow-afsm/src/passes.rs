@@ -16,11 +16,12 @@
 //! iterations in all (llvmpipe) still compute every pair.
 //!
 //! Each phase is submitted on its own and waited for, so [`Stats`] holds per-phase GPU times
-//! (submission to completion).
+//! (submission to completion); where the adapter has timestamp queries, counters
+//! `<phase>-device-ns` hold the device time of the phase's passes alone.
 
 use std::sync::{Arc, OnceLock};
 
-use shadow_core::gpu::{GpuContext, GpuError};
+use shadow_core::gpu::{Encoder, GpuContext, GpuError};
 use shadow_core::technique::Stats;
 
 use crate::params::{Params, Receiver, Region};
@@ -131,6 +132,28 @@ impl Pipelines {
     }
 }
 
+/// A device failure as a technique error.
+pub(crate) fn device_error(e: GpuError) -> shadow_core::technique::TechniqueError {
+    shadow_core::technique::TechniqueError::Device(e.to_string())
+}
+
+/// Runs phase `name` of `stats` (wall-clock time from submission to completion, readbacks
+/// included) and, where the device has timestamp queries, adds the device time of its passes
+/// to counter `name-device-ns` (a counter, not a phase, so phase totals stay wall-clock).
+fn timed<T>(
+    gpu: &GpuContext,
+    stats: &mut Stats,
+    name: &str,
+    f: impl FnOnce() -> Result<T, GpuError>,
+) -> Result<T, GpuError> {
+    gpu.take_device_seconds();
+    let out = stats.time(name, f)?;
+    if let Some(s) = gpu.take_device_seconds().filter(|s| *s > 0.0) {
+        stats.add(&format!("{name}-device-ns"), (s * 1e9).round() as u64);
+    }
+    Ok(out)
+}
+
 /// Exclusive prefix sum of the first `n` values of `data`, in place (recursive over block
 /// totals). Buffers that must outlive the submission go into `keep`.
 ///
@@ -139,7 +162,7 @@ impl Pipelines {
 pub fn scan(
     gpu: &GpuContext,
     pipes: &Pipelines,
-    enc: &mut wgpu::CommandEncoder,
+    enc: &mut Encoder,
     data: &wgpu::Buffer,
     n: u32,
     keep: &mut Vec<wgpu::Buffer>,
@@ -254,7 +277,7 @@ impl Occlusion<'_> {
         let (gpu, pipes) = (self.gpu, self.pipes);
         let mut p = params;
         p.kind[0] = batch.len;
-        stats.time("gpu-influence", || {
+        timed(gpu, stats, "gpu-influence", || {
             let uni = gpu.uniform("params", &p);
             let mut enc = gpu.encoder();
             let b = gpu.bind(&pipes.influence, &[&uni, &batch.buffer, self.regions]);
@@ -282,7 +305,7 @@ impl Occlusion<'_> {
         p.work = [base, count, 0, 0];
         let mut keep = Vec::new();
         let tile_counts = gpu.storage_zeroed("tile counts", (count as u64 + 1) * 4)?;
-        let tiles = stats.time("gpu-tiles", || {
+        let tiles = timed(gpu, stats, "gpu-tiles", || {
             let uni = gpu.uniform("params", &p);
             let mut enc = gpu.encoder();
             enc.clear_buffer(self.tallies, 4 * 2 * TILE_SLOT as u64, Some(16));
@@ -319,7 +342,7 @@ impl Occlusion<'_> {
         let batch = match work {
             Work::Occlude(batch) => batch,
             Work::Stencil => {
-                return stats.time("gpu-stencil", || {
+                return timed(gpu, stats, "gpu-stencil", || {
                     let uni = gpu.uniform("params", &p);
                     let mut enc = gpu.encoder();
                     let b = gpu.bind(
@@ -335,7 +358,7 @@ impl Occlusion<'_> {
         // are kept aside in case the range must be split and its tiles counted again.
         let pair_counts = gpu.storage_zeroed("pair counts", (3 * tiles + 1) * 4)?;
         let saved = gpu.storage_zeroed("saved tallies", TALLY_WORDS as u64 * 4)?;
-        let pairs = stats.time("gpu-tiles", || {
+        let pairs = timed(gpu, stats, "gpu-tiles", || {
             let uni = gpu.uniform("params", &p);
             let mut enc = gpu.encoder();
             enc.copy_buffer_to_buffer(self.tallies, 0, &saved, 0, TALLY_WORDS as u64 * 4);
@@ -389,7 +412,7 @@ impl Occlusion<'_> {
         // Pairs per invocation as `pairs_per_invocation` in `occlude.wgsl` deals them.
         let per_invocation = (64 / self.shared_words(&params)).clamp(1, 8) as u64;
         let groups = pairs.div_ceil(64 * per_invocation);
-        stats.time("gpu-occlude", || {
+        timed(gpu, stats, "gpu-occlude", || {
             let uni = gpu.uniform("params", &p);
             let mut enc = gpu.encoder();
             let b = gpu.bind(
@@ -469,23 +492,24 @@ pub fn run_batch(
     let texels = side * side;
     let mut keep = Vec::new();
     let tiles_per_side = side.div_ceil(8) as u64;
-    let (rbuf, counts, slots, lists, masks, result, tallies) = stats.time("gpu-upload", || {
-        Ok::<_, GpuError>((
-            gpu.storage("receivers", receivers)?,
-            gpu.storage_zeroed("list counts", (texels as u64 + 1) * 4)?,
-            gpu.storage_zeroed("slots", n as u64 * 8)?,
-            gpu.storage_zeroed("lists", n as u64 * 4)?,
-            gpu.storage_zeroed("masks", n as u64 * words as u64 * 4)?,
-            gpu.storage_zeroed("result", n as u64 * 16)?,
-            gpu.storage_zeroed("tallies", TALLY_WORDS as u64 * 4)?,
-        ))
-    })?;
+    let (rbuf, counts, slots, lists, masks, result, tallies) =
+        timed(gpu, stats, "gpu-upload", || {
+            Ok::<_, GpuError>((
+                gpu.storage("receivers", receivers)?,
+                gpu.storage_zeroed("list counts", (texels as u64 + 1) * 4)?,
+                gpu.storage_zeroed("slots", n as u64 * 8)?,
+                gpu.storage_zeroed("lists", n as u64 * 4)?,
+                gpu.storage_zeroed("masks", n as u64 * words as u64 * 4)?,
+                gpu.storage_zeroed("result", n as u64 * 16)?,
+                gpu.storage_zeroed("tallies", TALLY_WORDS as u64 * 4)?,
+            ))
+        })?;
     let texel_depth = gpu.storage_zeroed("texel depths", texels as u64 * 4)?;
     let tile_depth = gpu.storage_zeroed("tile depths", tiles_per_side * tiles_per_side * 4)?;
     let tile_box = gpu.storage_zeroed("tile boxes", tiles_per_side * tiles_per_side * 24)?;
     let uni = gpu.uniform("params", &params);
     let groups = (n as u64).div_ceil(64);
-    stats.time("gpu-lists", || {
+    timed(gpu, stats, "gpu-lists", || {
         let mut enc = gpu.encoder();
         let b = gpu.bind(
             &pipes.count,
@@ -551,7 +575,7 @@ pub fn run_batch(
             last_regions = gpu.read::<Region>(&regions, batch.len as usize)?;
         }
     }
-    stats.time("gpu-resolve", || {
+    timed(gpu, stats, "gpu-resolve", || {
         let mut enc = gpu.encoder();
         let b = gpu.bind(
             &pipes.resolve,
@@ -568,14 +592,17 @@ pub fn run_batch(
         gpu.dispatch(&mut enc, &pipes.resolve, &b, groups)?;
         gpu.submit(enc)
     })?;
-    stats.time("gpu-readback", || {
+    timed(gpu, stats, "gpu-readback", || {
         let t: Vec<u32> = gpu.read(&tallies, TALLY_WORDS)?;
         let word = |k: usize| t[2 * k] as u64 | (t[2 * k + 1] as u64) << 32;
         let mut tallies = [0u64; TALLIES.len()];
         for (k, v) in tallies.iter_mut().enumerate() {
             *v = word(k);
         }
-        let skipped = SKIPPED_SLOTS.iter().map(|&(k, name)| (name, word(k))).collect();
+        let skipped = SKIPPED_SLOTS
+            .iter()
+            .map(|&(k, name)| (name, word(k)))
+            .collect();
         Ok(BatchOutput {
             result: gpu.read(&result, n as usize)?,
             visible: gpu.read(&masks, (n * words) as usize)?,

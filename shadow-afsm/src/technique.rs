@@ -34,11 +34,11 @@ use shadow_core::technique::{Capabilities, Processor, SceneRef};
 use shadow_core::visibility::{PerSampleVisibility, PixelClass};
 
 use crate::frame::MapFrame;
-use crate::inputs::group_receivers;
 pub use crate::inputs::silhouette_edges;
+use crate::inputs::{casters_of, group_receivers, upload_casters};
 use crate::lut::PlaneLut;
 use crate::params::{Caster, LightBounds, OPAQUE, Params, Receiver, Region};
-use crate::passes::{CasterBatch, Pipelines, Shared, TALLIES, run_batch};
+use crate::passes::{CasterBatch, Pipelines, Shared, TALLIES, device_error, run_batch};
 use crate::sample_grid::SampleGrid;
 
 /// How the occlusion pass finds the samples behind a plane (section 4.2).
@@ -124,43 +124,6 @@ impl std::fmt::Debug for Afsm {
             .field("plane_test", &self.plane_test)
             .finish_non_exhaustive()
     }
-}
-
-fn device_error(e: GpuError) -> TechniqueError {
-    TechniqueError::Device(e.to_string())
-}
-
-/// The casters of `scene`: every triangle that hides anything (fully transparent ones are
-/// left out), flagged closed when its component is in `closed`.
-fn casters_of(scene: &dyn Scene, closed: &[bool]) -> Vec<Caster> {
-    let topo = scene.topology();
-    let opacities = scene.opacities();
-    (0..scene.triangle_count())
-        .filter(|&t| opacities[t] > 0.0)
-        .map(|t| {
-            Caster::new(scene.triangle(t), t as u32, closed[topo.component_of(t)])
-                .with_opacity(opacities[t])
-        })
-        .collect()
-}
-
-/// `casters` in buffers of at most `per` casters each.
-fn upload_casters(
-    gpu: &GpuContext,
-    casters: &[Caster],
-    per: usize,
-    label: &str,
-) -> Result<Vec<CasterBatch>, TechniqueError> {
-    casters
-        .chunks(per)
-        .map(|c| {
-            Ok(CasterBatch {
-                buffer: gpu.storage(label, c)?,
-                len: c.len() as u32,
-            })
-        })
-        .collect::<Result<Vec<_>, GpuError>>()
-        .map_err(device_error)
 }
 
 impl Afsm {

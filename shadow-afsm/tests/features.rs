@@ -398,3 +398,47 @@ fn receivers_inside_a_closed_mesh_are_shadowed() {
         );
     }
 }
+
+/// Where the adapter has timestamp queries (lavapipe has), each GPU phase's device time is a
+/// counter beside its wall-clock time, and never longer than it: the device time leaves out
+/// submission, waiting and readbacks.
+#[test]
+fn device_times_from_timestamp_queries_fit_inside_their_phases() {
+    let Some(gpu) = context_for_test("device_times_from_timestamp_queries_fit_inside_their_phases")
+    else {
+        return;
+    };
+    if !gpu.has_timestamps() {
+        eprintln!(
+            "SKIPPED: adapter {} has no timestamp queries",
+            gpu.describe()
+        );
+        return;
+    }
+    let (setup, view) = setup_view("contact", 48, 36);
+    let a = Afsm::new(32, SamplingStrategy::Interleaved { tile: 2 }, 1).unwrap();
+    let est = a
+        .prepare(setup.scene.clone(), Arc::clone(&setup.lights[0]))
+        .unwrap()
+        .estimate(&view, Outputs::VISIBILITY)
+        .unwrap();
+    for phase in [
+        "gpu-lists",
+        "gpu-influence",
+        "gpu-tiles",
+        "gpu-occlude",
+        "gpu-resolve",
+    ] {
+        let wall = est.stats.phase_seconds(phase).expect("phase ran");
+        let device = est
+            .stats
+            .counter(&format!("{phase}-device-ns"))
+            .unwrap_or_else(|| panic!("{phase}: no device time"));
+        println!(
+            "{phase}: wall {wall:.5} s, device {:.5} s",
+            device as f64 * 1e-9
+        );
+        assert!(device > 0, "{phase}");
+        assert!(device as f64 * 1e-9 <= wall * 1.01 + 1e-4, "{phase}");
+    }
+}

@@ -22,6 +22,8 @@ use bytemuck::Pod;
 use thiserror::Error;
 use wgpu::util::DeviceExt;
 
+pub use crate::gpu_timestamps::Encoder;
+
 /// Environment variable that turns a missing adapter into a failure.
 pub const REQUIRE_GPU_ENV: &str = "SHADOW_REQUIRE_GPU";
 
@@ -70,6 +72,11 @@ pub struct GpuContext {
     limits: wgpu::Limits,
     errors: Arc<Mutex<Vec<String>>>,
     exclusive: Mutex<()>,
+    /// Nanoseconds per timestamp tick, where the device has timestamp queries.
+    timestamp_period: Option<f32>,
+    /// Device seconds of the timed passes submitted since the last take; `None` once an
+    /// untimed pass was among them.
+    device_seconds: Mutex<Option<f64>>,
 }
 
 impl std::fmt::Debug for GpuContext {
@@ -142,9 +149,10 @@ impl GpuContext {
             .filter(|s| !s.is_empty());
         let adapter = choose(adapters, name.as_deref())?;
         let limits = adapter.limits();
+        let timestamps = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("shadow-core"),
-            required_features: wgpu::Features::empty(),
+            required_features: timestamps,
             required_limits: limits.clone(),
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,
@@ -158,6 +166,7 @@ impl GpuContext {
                 v.push(e.to_string());
             }
         }));
+        let timestamp_period = (!timestamps.is_empty()).then(|| queue.get_timestamp_period());
         Ok(Self {
             device,
             queue,
@@ -165,6 +174,8 @@ impl GpuContext {
             limits,
             errors,
             exclusive: Mutex::new(()),
+            timestamp_period,
+            device_seconds: Mutex::new(Some(0.0)),
         })
     }
 
@@ -463,7 +474,7 @@ impl GpuContext {
     /// As [`GpuContext::grid`].
     pub fn dispatch(
         &self,
-        enc: &mut wgpu::CommandEncoder,
+        enc: &mut Encoder,
         pipeline: &wgpu::ComputePipeline,
         bind: &wgpu::BindGroup,
         groups: u64,
@@ -472,9 +483,11 @@ impl GpuContext {
             return Ok(());
         }
         let (x, y) = self.grid(groups)?;
-        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        let Encoder { inner, queries } = enc;
+        let timestamp_writes = queries.as_mut().and_then(|q| q.next_pass());
+        let mut pass = inner.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: None,
-            timestamp_writes: None,
+            timestamp_writes,
         });
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, bind, &[]);
@@ -482,18 +495,92 @@ impl GpuContext {
         Ok(())
     }
 
-    /// Submits `enc` and waits for it (per-phase timing submits each phase on its own).
+    /// Submits `enc` and waits for it (per-phase timing submits each phase on its own). With
+    /// timestamp queries, the device time of its passes is read back and added to
+    /// [`GpuContext::take_device_seconds`]'s total.
     ///
     /// # Errors
-    /// As [`GpuContext::wait`].
-    pub fn submit(&self, enc: wgpu::CommandEncoder) -> Result<(), GpuError> {
-        self.queue.submit([enc.finish()]);
-        self.wait()
+    /// As [`GpuContext::wait`] and [`GpuContext::read`].
+    pub fn submit(&self, enc: Encoder) -> Result<(), GpuError> {
+        let Encoder { mut inner, queries } = enc;
+        let timed = match queries {
+            Some(q) if q.used > 0 => {
+                let bytes = q.used as u64 * 8;
+                let resolve = self.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("timestamps"),
+                    size: bytes,
+                    usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                    mapped_at_creation: false,
+                });
+                inner.resolve_query_set(&q.set, 0..q.used, &resolve, 0);
+                Some((resolve, q.used, q.untimed))
+            }
+            Some(q) => {
+                if q.untimed {
+                    self.add_device_seconds(None);
+                }
+                None
+            }
+            None => None,
+        };
+        self.queue.submit([inner.finish()]);
+        self.wait()?;
+        if let (Some((resolve, used, untimed)), Some(period)) = (timed, self.timestamp_period) {
+            let ticks: Vec<u64> = self.read(&resolve, used as usize)?;
+            let s = crate::gpu_timestamps::pass_seconds(&ticks, period);
+            self.add_device_seconds((!untimed).then_some(s));
+        }
+        Ok(())
     }
 
-    /// A new command encoder.
-    pub fn encoder(&self) -> wgpu::CommandEncoder {
-        self.device.create_command_encoder(&Default::default())
+    fn add_device_seconds(&self, s: Option<f64>) {
+        let mut total = self
+            .device_seconds
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        *total = match (*total, s) {
+            (Some(t), Some(s)) => Some(t + s),
+            _ => None,
+        };
+    }
+
+    /// Whether the device has timestamp queries (so [`GpuContext::take_device_seconds`]
+    /// reports device time).
+    pub fn has_timestamps(&self) -> bool {
+        self.timestamp_period.is_some()
+    }
+
+    /// The device time (seconds, from timestamp queries) of the compute passes submitted
+    /// since the last call, and starts a new total. `None` without timestamp queries, or when
+    /// some pass since the last call ran untimed (an encoder past its query capacity).
+    pub fn take_device_seconds(&self) -> Option<f64> {
+        let mut total = self
+            .device_seconds
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        let out = if self.has_timestamps() { *total } else { None };
+        *total = Some(0.0);
+        out
+    }
+
+    /// A new command encoder, with a query set for its passes' timestamps where the device
+    /// has them.
+    pub fn encoder(&self) -> Encoder {
+        let queries = self
+            .timestamp_period
+            .map(|_| crate::gpu_timestamps::Queries {
+                set: self.device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("pass timestamps"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: crate::gpu_timestamps::CAPACITY,
+                }),
+                used: 0,
+                untimed: false,
+            });
+        Encoder {
+            inner: self.device.create_command_encoder(&Default::default()),
+            queries,
+        }
     }
 }
 

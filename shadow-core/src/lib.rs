@@ -47,6 +47,8 @@ pub mod direct;
 pub mod geometry;
 #[cfg(feature = "gpu")]
 pub mod gpu;
+#[cfg(feature = "gpu")]
+mod gpu_timestamps;
 pub mod image_io;
 pub mod irradiance;
 pub mod light;
