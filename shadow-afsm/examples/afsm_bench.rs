@@ -98,6 +98,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "tiles-culled",
         "texels-culled-by-depth",
         "pairs-after-umbra",
+        "tiles-empty",
+        "texels-hidden",
+        "tiles-hidden",
         "tiles-numbered",
     ] {
         println!("  {k} {}", est.stats.counter(k).unwrap_or(0));

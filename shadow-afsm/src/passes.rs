@@ -34,7 +34,7 @@ pub const TALLY: &str = include_str!("shaders/tally.wgsl");
 pub const TILING: &str = include_str!("shaders/tiling.wgsl");
 
 /// Every pass: name, source, and the prefixes it is compiled with, in order.
-pub const MODULES: [(&str, &str, &[&str]); 10] = [
+pub const MODULES: [(&str, &str, &[&str]); 11] = [
     ("count", include_str!("shaders/count.wgsl"), &[COMMON]),
     ("scan_block", include_str!("shaders/scan_block.wgsl"), &[]),
     ("scan_add", include_str!("shaders/scan_add.wgsl"), &[]),
@@ -65,6 +65,7 @@ pub const MODULES: [(&str, &str, &[&str]); 10] = [
         &[COMMON, TILING],
     ),
     ("resolve", include_str!("shaders/resolve.wgsl"), &[COMMON]),
+    ("hidden", include_str!("shaders/hidden.wgsl"), &[COMMON]),
 ];
 
 /// The full WGSL source of pass `name`.
@@ -95,6 +96,7 @@ pub struct Pipelines {
     occlude: wgpu::ComputePipeline,
     stencil: wgpu::ComputePipeline,
     resolve: wgpu::ComputePipeline,
+    hidden: wgpu::ComputePipeline,
 }
 
 impl Pipelines {
@@ -115,6 +117,7 @@ impl Pipelines {
             occlude: p("occlude")?,
             stencil: p("stencil")?,
             resolve: p("resolve")?,
+            hidden: p("hidden")?,
         })
     }
 
@@ -222,19 +225,25 @@ enum Work<'a> {
     Stencil,
 }
 
+/// Casters per occlusion range: between ranges, texels whose every view sample is hidden drop
+/// out (on `grass`, most of them after the first range).
+const RANGE_CASTERS: u32 = 4096;
+
 /// 64-bit tally slots beyond [`TALLIES`]: tiles and pairs of the current caster range.
 const TILE_SLOT: usize = 7;
 const PAIR_SLOT: usize = 8;
 /// The tallies of work skipped, kept over every range: cluster culling's (`tile_pairs.wgsl`)
 /// and the pairs whose view sample was already hidden from every light sample (`occlude.wgsl`).
-const SKIPPED_SLOTS: [(usize, &str); 4] = [
+const SKIPPED_SLOTS: [(usize, &str); 6] = [
     (9, "tiles-culled"),
     (10, "texels-culled-by-depth"),
     (11, "pairs-after-umbra"),
     (12, "tiles-empty"),
+    (13, "texels-hidden"),
+    (14, "tiles-hidden"),
 ];
-/// Tallies buffer length in u32 words (thirteen 64-bit slots).
-const TALLY_WORDS: usize = 26;
+/// Tallies buffer length in u32 words (fifteen 64-bit slots).
+const TALLY_WORDS: usize = 30;
 
 /// The buffers one batch of view samples shares between its caster ranges.
 struct Occlusion<'a> {
@@ -252,6 +261,10 @@ struct Occlusion<'a> {
     tile_depth: &'a wgpu::Buffer,
     texel_depth: &'a wgpu::Buffer,
     tile_box: &'a wgpu::Buffer,
+    slots: &'a wgpu::Buffer,
+    texel_hidden: &'a wgpu::Buffer,
+    tile_count: &'a wgpu::Buffer,
+    tile_hidden: &'a wgpu::Buffer,
 }
 
 impl Occlusion<'_> {
@@ -285,7 +298,50 @@ impl Occlusion<'_> {
             gpu.dispatch(&mut enc, &pipes.influence, &b, groups)?;
             gpu.submit(enc)
         })?;
-        self.range(p, work, 0, batch.len, stats)
+        // Occlusion runs over ranges of casters, and between them the texels whose every view
+        // sample is already hidden drop out of the later ranges' pairs.
+        let step = match work {
+            Work::Occlude(_) => RANGE_CASTERS,
+            Work::Stencil => batch.len.max(1),
+        };
+        let mut base = 0;
+        while base < batch.len {
+            let count = step.min(batch.len - base);
+            self.range(p, work, base, count, stats)?;
+            if let Work::Occlude(_) = work {
+                self.refresh_hidden(&p, stats)?;
+            }
+            base += count;
+        }
+        Ok(())
+    }
+
+    /// Recounts each texel's view samples hidden from every light sample (`hidden.wgsl`).
+    fn refresh_hidden(&self, params: &Params, stats: &mut Stats) -> Result<(), GpuError> {
+        let (gpu, pipes) = (self.gpu, self.pipes);
+        timed(gpu, stats, "gpu-hidden", || {
+            let uni = gpu.uniform("params", params);
+            let mut enc = gpu.encoder();
+            enc.clear_buffer(self.texel_hidden, 0, None);
+            enc.clear_buffer(self.tile_hidden, 0, None);
+            let b = gpu.bind(
+                &pipes.hidden,
+                &[
+                    &uni,
+                    self.slots,
+                    self.masks,
+                    self.texel_hidden,
+                    self.tile_hidden,
+                ],
+            );
+            gpu.dispatch(
+                &mut enc,
+                &pipes.hidden,
+                &b,
+                (params.dims[1] as u64).div_ceil(64),
+            )?;
+            gpu.submit(enc)
+        })
     }
 
     /// Tiles, then the stencil or the pairs and their occlusion, for casters
@@ -375,6 +431,9 @@ impl Occlusion<'_> {
                     self.tile_depth,
                     self.texel_depth,
                     self.tile_box,
+                    self.texel_hidden,
+                    self.tile_count,
+                    self.tile_hidden,
                 ],
             );
             gpu.dispatch(&mut enc, &pipes.tile_pairs, &b, tiles.div_ceil(64))?;
@@ -507,6 +566,9 @@ pub fn run_batch(
     let texel_depth = gpu.storage_zeroed("texel depths", texels as u64 * 4)?;
     let tile_depth = gpu.storage_zeroed("tile depths", tiles_per_side * tiles_per_side * 4)?;
     let tile_box = gpu.storage_zeroed("tile boxes", tiles_per_side * tiles_per_side * 24)?;
+    let texel_hidden = gpu.storage_zeroed("hidden per texel", texels as u64 * 4)?;
+    let tile_count = gpu.storage_zeroed("view samples per tile", tiles_per_side.pow(2) * 4)?;
+    let tile_hidden = gpu.storage_zeroed("hidden per tile", tiles_per_side.pow(2) * 4)?;
     let uni = gpu.uniform("params", &params);
     let groups = (n as u64).div_ceil(64);
     timed(gpu, stats, "gpu-lists", || {
@@ -521,6 +583,7 @@ pub fn run_batch(
                 &texel_depth,
                 &tile_depth,
                 &tile_box,
+                &tile_count,
             ],
         );
         gpu.dispatch(&mut enc, &pipes.count, &b, groups)?;
@@ -564,6 +627,10 @@ pub fn run_batch(
         tile_depth: &tile_depth,
         texel_depth: &texel_depth,
         tile_box: &tile_box,
+        slots: &slots,
+        texel_hidden: &texel_hidden,
+        tile_count: &tile_count,
+        tile_hidden: &tile_hidden,
     };
     for batch in shared.silhouettes {
         occ.batch(params, batch, Work::Stencil, stats)?;

@@ -201,7 +201,8 @@ impl Afsm {
         self
     }
 
-    /// Turns cluster culling off (`tile_pairs.wgsl`): every view sample listed in a texel of a
+    /// Turns cluster culling off (`tile_pairs.wgsl`), and the skipping of texels and tiles
+    /// whose view samples are all hidden already: every view sample listed in a texel of a
     /// caster's influence region is tested against it, as in the paper. The output is the
     /// same sample for sample; only the work differs (tests compare the two).
     pub fn without_cluster_culling(mut self) -> Self {

@@ -2,7 +2,9 @@
 //! same bit for every (view sample, light sample) pair, on scenes that exercise each of its
 //! tests (a room around the light for the supporting-plane test, a mesh on a floor for the
 //! depth and region tests, a sphere light whose far side lies beyond some view samples, a
-//! disk light, semi-opaque casters), while testing fewer pairs.
+//! disk light, semi-opaque casters, and grass, where most view samples are hidden from every
+//! light sample after the first range of casters and their texels drop out of later ranges),
+//! while testing fewer pairs.
 
 use std::sync::Arc;
 
@@ -25,6 +27,7 @@ fn cluster_culling_changes_no_bit_and_tests_fewer_pairs() {
         "contact",
         "semi-opaque",
         "large-light-close",
+        "grass",
     ] {
         let setup = builtin(name).unwrap();
         let view =
@@ -44,11 +47,12 @@ fn cluster_culling_changes_no_bit_and_tests_fewer_pairs() {
         let count = |e: &Estimate, k: &str| e.stats.counter(k).expect("AFSM counts it");
         println!(
             "{name:<18} pairs tested {} -> {}, tiles culled {}, texels culled by depth {}, \
-             agreement {:.7}",
+             texels hidden {}, agreement {:.7}",
             count(&plain, "pairs-tested"),
             count(&culled, "pairs-tested"),
             count(&culled, "tiles-culled"),
             count(&culled, "texels-culled-by-depth"),
+            count(&culled, "texels-hidden"),
             m.sample_agreement.unwrap()
         );
         assert_eq!(m.sample_agreement, Some(1.0), "{name}: {m:?}");
@@ -59,6 +63,10 @@ fn cluster_culling_changes_no_bit_and_tests_fewer_pairs() {
             "{name}"
         );
         fewer_somewhere |= count(&culled, "pairs-tested") * 2 < count(&plain, "pairs-tested");
+        if name == "grass" {
+            assert!(count(&culled, "texels-hidden") > 0, "{name}");
+            assert_eq!(count(&plain, "texels-hidden"), 0, "{name}");
+        }
     }
     assert!(
         fewer_somewhere,

@@ -12,14 +12,17 @@
 // monotonically with depth). A tile beyond which the caster lies, or outside that smaller
 // region, gets no pairs (tally 9: tiles culled; tiles with no view sample, tally 12, get none
 // either); within a surviving tile, texels whose view samples all lie before the caster are
-// skipped (tally 10). Both tests are
+// skipped (tally 10), as are texels whose every view sample is already hidden from every
+// light sample by earlier ranges of casters (tally 13, `hidden.wgsl`; whole tiles, tally 14).
+// The tests are
 // conservative: they drop only pairs the occlusion test would find empty.
 //
 // Before that, the caster's supporting plane is tested against the tile's box of ray origins
 // and the light: when both lie strictly on one side, no segment between them crosses the
 // caster (a wall or a floor of a room around the light casts on none of its receivers), and
 // a closed mesh's caster with every origin behind it casts on none (section 3.3).
-// `P.options.w` = 0 turns cluster culling off (for the test that compares both).
+// `P.options.w` = 0 turns cluster culling and the skipping of hidden texels and tiles off (for
+// the tests that compare both).
 
 @group(0) @binding(0) var<uniform> P: Params;
 @group(0) @binding(4) var<storage, read_write> pair_counts: array<u32>;
@@ -28,6 +31,11 @@
 @group(0) @binding(7) var<storage, read> tile_depth: array<u32>;
 @group(0) @binding(8) var<storage, read> texel_depth: array<u32>;
 @group(0) @binding(9) var<storage, read> tile_box: array<u32>;
+// Per texel, its view samples already hidden from every light sample (`hidden.wgsl`).
+@group(0) @binding(10) var<storage, read> texel_hidden: array<u32>;
+// Per tile, its view samples and those of them already hidden (`count.wgsl`, `hidden.wgsl`).
+@group(0) @binding(11) var<storage, read> tile_count: array<u32>;
+@group(0) @binding(12) var<storage, read> tile_hidden: array<u32>;
 
 // Depth of a point from the light's centre along the frustum axis.
 fn depth_of(p: vec3<f32>) -> f32 {
@@ -157,6 +165,10 @@ fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n:
         return;
     }
     let culling = P.options.w == 1u;
+    if culling && tile_hidden[tl.index] >= tile_count[tl.index] {
+        add64(14u, 1u);
+        return;
+    }
     if culling && !cluster_may_shadow(tl, zt) {
         add64(9u, 1u);
         return;
@@ -165,10 +177,15 @@ fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n:
     var visited = 0u;
     var pairs = 0u;
     var skipped = 0u;
+    var hidden = 0u;
     var mask = vec2<u32>(0u);
     for (var k = 0u; k < 64u; k++) {
         let tt = tile_texel(tl, k);
         if tt.y > 0u {
+            if culling && texel_hidden[tt.x] >= tt.y {
+                hidden++;
+                continue;
+            }
             if bitcast<f32>(texel_depth[tt.x]) < near {
                 skipped++;
                 continue;
@@ -185,4 +202,5 @@ fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n:
     add64(1u, pairs);
     add64(8u, pairs);
     add64(10u, skipped);
+    add64(13u, hidden);
 }
