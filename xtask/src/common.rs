@@ -123,6 +123,8 @@ pub fn list_scenes() -> Result<(), String> {
         "open room, light recessed in a ceiling fixture, two spheres",
         "glTF file's KHR_lights_punctual spot light over a table and a ball",
         "folded mesh light (two one-sided faces) over a box and a sphere",
+        "furnished room under a ceiling panel: large light, many occluders",
+        "the furnished room lit by a window-sized light in a wall",
     ];
     for (name, what) in BUILTIN_SCENES.iter().zip(what) {
         let s = builtin(name).map_err(|e| e.to_string())?;

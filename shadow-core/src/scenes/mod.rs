@@ -16,6 +16,8 @@
 //! | `cornell-box` | an open five-wall room, the light recessed in a ceiling fixture, two spheres: receivers level with and behind the light, walls touching its fixture |
 //! | `spot-lamp` | a glTF file's `KHR_lights_punctual` spot light (a disk of radius 0.25 m) over a table on legs and a ball, loaded like a user's file |
 //! | `mesh-light` | a folded lamp (a mesh light, its two faces emitting from their undersides) over a box and a sphere: receivers that see one face, both or none |
+//! | `interior` | a furnished room (table, chairs, shelves of books, a sofa, Spot on the table; 7.4k triangles) under a 1.2 x 0.6 m ceiling panel: a large light over many occluders, walls up to the light's plane |
+//! | `interior-window` | the same room lit by a window-sized light in a wall: receivers level with the light and behind it |
 
 use std::sync::Arc;
 
@@ -31,8 +33,11 @@ use crate::load::{LoadError, LoadLimits, SceneSetup};
 use crate::procedural::{Mesh, cuboid, floor, grass, quad, uv_sphere};
 use crate::scene::{MeshDesc, SceneBuilder};
 
+mod interior;
+pub use interior::ROOM_HALF;
+
 /// Names of the built-in scenes, in a stable order.
-pub const BUILTIN_SCENES: [&str; 13] = [
+pub const BUILTIN_SCENES: [&str; 15] = [
     "quad-over-plane",
     "overlapping-occluders",
     "large-light-close",
@@ -46,12 +51,14 @@ pub const BUILTIN_SCENES: [&str; 13] = [
     "cornell-box",
     "spot-lamp",
     "mesh-light",
+    "interior",
+    "interior-window",
 ];
 
-const BUNNY_OBJ: &[u8] = include_bytes!("../assets/models/stanford-bunny.obj");
-const SPOT_OBJ: &[u8] = include_bytes!("../assets/models/spot.obj");
+const BUNNY_OBJ: &[u8] = include_bytes!("../../assets/models/stanford-bunny.obj");
+const SPOT_OBJ: &[u8] = include_bytes!("../../assets/models/spot.obj");
 /// Written by `scripts/make_spot_lamp_gltf.py`.
-const SPOT_LAMP_GLTF: &[u8] = include_bytes!("../assets/scenes/spot-lamp.gltf");
+const SPOT_LAMP_GLTF: &[u8] = include_bytes!("../../assets/scenes/spot-lamp.gltf");
 /// The radius `spot-lamp` gives its file's spot light.
 pub const SPOT_LAMP_RADIUS: f32 = 0.25;
 
@@ -321,6 +328,8 @@ pub fn builtin(name: &str) -> Result<SceneSetup, BuiltinError> {
             camera: cam(Vec3::new(1.6, 2.0, 1.9), Vec3::new(-0.2, 0.5, -0.3), 70.0),
         },
         "cornell-box" => cornell_box()?,
+        "interior" => interior::ceiling_panel()?,
+        "interior-window" => interior::window()?,
         "mesh-light" => Parts {
             meshes: vec![
                 mesh(floor(6.0, 0.0)),
