@@ -10,6 +10,6 @@ cargo build -q --release -p shadow-afsm --example afsm_bench
 echo "| scene | AFSM s | reference s | AFSM / reference | pairs tested | empty | tiles culled | pairs after umbra |"
 echo "|---|---|---|---|---|---|---|---|"
 for s in quad-over-plane overlapping-occluders large-light-close bunny spot-self-shadow grass \
-    contact semi-opaque textured-light sphere-light cornell-box spot-lamp; do
+    contact semi-opaque textured-light sphere-light cornell-box spot-lamp interior interior-window; do
     target/release/examples/afsm_bench "$s" "$w" "$h" "$n" "$mode" 2>/dev/null | tail -1
 done

@@ -536,10 +536,12 @@ impl PreparedReference {
     }
 
     /// The occlusion segment from view sample `s` to light sample `y`: robust origin, unit
-    /// direction and length, or `None` when `y` is below the receiver's tangent plane or, on a
-    /// light whose samples emit from one side (a mesh light), faces away from the receiver.
+    /// direction and length, or `None` when `y` is below the receiver's tangent plane, when
+    /// the receiver lies behind a planar light (which emits from its front side only: the
+    /// estimate darkens such pixels), or, on a light whose samples emit from one side (a mesh
+    /// light), when `y` faces away from the receiver.
     pub fn segment(&self, s: &ViewSample, y: &LightSample) -> Option<(Vec3, Vec3, f32)> {
-        if !self.p.faces(s, y) {
+        if !self.p.faces(s, y) || self.p.light.geometry().behind(s.position) {
             return None;
         }
         segment(&self.p, s, y.position)
