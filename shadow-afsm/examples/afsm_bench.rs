@@ -101,6 +101,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "tiles-empty",
         "texels-hidden",
         "tiles-hidden",
+        "texels-culled-by-region",
         "tiles-numbered",
     ] {
         println!("  {k} {}", est.stats.counter(k).unwrap_or(0));

@@ -234,16 +234,17 @@ const TILE_SLOT: usize = 7;
 const PAIR_SLOT: usize = 8;
 /// The tallies of work skipped, kept over every range: cluster culling's (`tile_pairs.wgsl`)
 /// and the pairs whose view sample was already hidden from every light sample (`occlude.wgsl`).
-const SKIPPED_SLOTS: [(usize, &str); 6] = [
+const SKIPPED_SLOTS: [(usize, &str); 7] = [
     (9, "tiles-culled"),
     (10, "texels-culled-by-depth"),
     (11, "pairs-after-umbra"),
     (12, "tiles-empty"),
     (13, "texels-hidden"),
     (14, "tiles-hidden"),
+    (15, "texels-culled-by-region"),
 ];
-/// Tallies buffer length in u32 words (fifteen 64-bit slots).
-const TALLY_WORDS: usize = 30;
+/// Tallies buffer length in u32 words (sixteen 64-bit slots).
+const TALLY_WORDS: usize = 32;
 
 /// The buffers one batch of view samples shares between its caster ranges.
 struct Occlusion<'a> {

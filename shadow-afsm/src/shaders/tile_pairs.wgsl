@@ -12,7 +12,8 @@
 // monotonically with depth). A tile beyond which the caster lies, or outside that smaller
 // region, gets no pairs (tally 9: tiles culled; tiles with no view sample, tally 12, get none
 // either); within a surviving tile, texels whose view samples all lie before the caster are
-// skipped (tally 10), as are texels whose every view sample is already hidden from every
+// skipped (tally 10), as are texels outside the region drawn at their own farthest depth
+// (tally 15), as are texels whose every view sample is already hidden from every
 // light sample by earlier ranges of casters (tally 13, `hidden.wgsl`; whole tiles, tally 14).
 // The tests are
 // conservative: they drop only pairs the occlusion test would find empty.
@@ -76,20 +77,61 @@ fn plane_separates(tl: Tile) -> bool {
     return front || back || (tri.closed == 1u && centre + reach < -eps);
 }
 
-// Whether caster t may hide part of the light from a view sample of tile `tl`, whose view
-// samples lie at depth `zt` or less.
-fn cluster_may_shadow(tl: Tile, zt: f32) -> bool {
+// A caster's influence region as a function of depth: each of its points (the clipped
+// caster's vertices p, and for each of them the points f(z) where the lines from the light's
+// bounding points y through p reach depth z) has texel coordinates a + b / z (for f:
+// a = k, b = (p - c).u - z_p k with k = (p - y).u / (z_p - z_y), then scaled to texels), valid
+// for z at or beyond `deepest`, the clipped caster's deepest point. Its hull at depth z (here
+// bounded by its box) holds the projections of every view sample at depth z or less that
+// the caster can shadow.
+struct DepthRegion {
+    n: u32,
+    a: array<vec2<f32>, 36>,
+    b: array<vec2<f32>, 36>,
+    deepest: f32,
+}
+
+// The box (lo.xy, hi.xy) in texels of the region at depth z.
+fn region_box(r: ptr<function, DepthRegion>, z: f32) -> vec4<f32> {
+    var lo = vec2<f32>(3.4e38);
+    var hi = vec2<f32>(-3.4e38);
+    let w = 1.0 / z;
+    for (var k = 0u; k < (*r).n; k++) {
+        let q = (*r).a[k] + (*r).b[k] * w;
+        lo = min(lo, q);
+        hi = max(hi, q);
+    }
+    return vec4<f32>(lo, hi);
+}
+
+// Whether a box of texels lies apart from the `size` x `size` texels from `origin`, with a pad
+// for rounding. View samples project into their own texel, but are clamped into the map at its
+// edges, so the map's edges are open.
+fn box_apart(box: vec4<f32>, origin: vec2<i32>, size: i32) -> bool {
+    let side = i32(P.dims.x);
+    let pad = 0.02 + 1e-5 * f32(side);
+    let t0 = vec2<f32>(origin) - pad;
+    let t1 = vec2<f32>(origin + vec2<i32>(size)) + pad;
+    let open_lo = origin <= vec2<i32>(0);
+    let open_hi = origin + vec2<i32>(size) >= vec2<i32>(side);
+    return any((box.zw < t0) & !open_lo) || any((box.xy > t1) & !open_hi);
+}
+
+// Cluster culling of caster t against tile `tl`, whose view samples lie at depth `zt` or less:
+// 0 when the caster cannot shadow any of them, 1 when it may and no region bounds it (a point
+// at or behind the light's depth), 2 when it may and `r` holds its region for the texel tests.
+fn cluster_region(tl: Tile, zt: f32, r: ptr<function, DepthRegion>) -> u32 {
     if plane_separates(tl) {
-        return false;
+        return 0u;
     }
     let tri = casters[tl.caster];
     let zfar = P.axis_d.w;
     if near_depth(tl.caster) > zt {
-        return false;
+        return 0u;
     }
     // The construction below needs the whole light before the view samples.
     if light_far() + 1e-5 * zfar >= zt {
-        return true;
+        return 1u;
     }
     // The caster clipped to depth <= zt (a triangle gives at most four points).
     var v = array<vec3<f32>, 3>(tri.a, tri.b, tri.c);
@@ -109,46 +151,43 @@ fn cluster_may_shadow(tl: Tile, zt: f32) -> bool {
             np++;
         }
     }
-    // The region at depth zt, bounded by its box in texels (section 4.1's points).
-    var lo = vec2<f32>(3.4e38);
-    var hi = vec2<f32>(-3.4e38);
+    // Section 4.1's points, as functions of depth.
     let c = P.center.xyz;
+    let scale = P.map.zw;
+    (*r).n = 0u;
+    (*r).deepest = 0.0;
     for (var k = 0u; k < np; k++) {
         let p = poly[k];
         let zp = min(depth_of(p), zt);
         if zp <= 1e-6 * zfar {
-            return true;
+            return 1u;
         }
-        let own = to_texel(project(p).xy);
-        lo = min(lo, own);
-        hi = max(hi, own);
+        (*r).deepest = max((*r).deepest, zp);
+        let pc = vec2<f32>(dot(p - c, P.axis_u.xyz), dot(p - c, P.axis_v.xyz));
+        (*r).a[(*r).n] = to_texel(pc / zp);
+        (*r).b[(*r).n] = vec2<f32>(0.0);
+        (*r).n++;
         var ys: array<vec3<f32>, 8>;
         let found = light_points(p, &ys);
         if found < 0 {
-            return true;
+            return 1u;
         }
         for (var j = 0u; j < u32(found); j++) {
             let zy = depth_of(ys[j]);
             if zp - zy <= 1e-6 * zfar {
-                return true;
+                return 1u;
             }
-            let f = p + ((zt - zp) / (zp - zy)) * (p - ys[j]) - c;
-            let ft = to_texel(vec2<f32>(dot(f, P.axis_u.xyz), dot(f, P.axis_v.xyz)) / zt);
-            lo = min(lo, ft);
-            hi = max(hi, ft);
+            let py = p - ys[j];
+            let k2 = vec2<f32>(dot(py, P.axis_u.xyz), dot(py, P.axis_v.xyz)) / (zp - zy);
+            (*r).a[(*r).n] = to_texel(k2);
+            (*r).b[(*r).n] = (pc - zp * k2) * scale;
+            (*r).n++;
         }
     }
-    // The tile's view samples project into its texels; at the map's edges, also beyond them
-    // (projections are clamped into the map). A small pad covers rounding.
-    let side = i32(P.dims.x);
-    let pad = 0.02 + 1e-5 * f32(side);
-    let t0 = vec2<f32>(tl.origin) - pad;
-    let t1 = vec2<f32>(tl.origin + vec2<i32>(TILE)) + pad;
-    let open_lo = tl.origin <= vec2<i32>(0);
-    let open_hi = tl.origin + vec2<i32>(TILE) >= vec2<i32>(side);
-    let apart_lo = (hi < t0) & !open_lo;
-    let apart_hi = (lo > t1) & !open_hi;
-    return !(any(apart_lo) || any(apart_hi));
+    if box_apart(region_box(r, zt), tl.origin, TILE) {
+        return 0u;
+    }
+    return 2u;
 }
 
 @compute @workgroup_size(64)
@@ -169,25 +208,44 @@ fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n:
         add64(14u, 1u);
         return;
     }
-    if culling && !cluster_may_shadow(tl, zt) {
-        add64(9u, 1u);
-        return;
+    var region: DepthRegion;
+    var bounded = false;
+    if culling {
+        let verdict = cluster_region(tl, zt, &region);
+        if verdict == 0u {
+            add64(9u, 1u);
+            return;
+        }
+        bounded = verdict == 2u;
     }
     let near = select(-3.4e38, near_depth(tl.caster), culling);
     var visited = 0u;
     var pairs = 0u;
     var skipped = 0u;
+    var outside = 0u;
     var hidden = 0u;
     var mask = vec2<u32>(0u);
+    // The cheap tests first, the hull (section 3.2's conservative rasterisation) last.
     for (var k = 0u; k < 64u; k++) {
-        let tt = tile_texel(tl, k);
+        let tt = tile_texel_list(tl, k);
         if tt.y > 0u {
             if culling && texel_hidden[tt.x] >= tt.y {
                 hidden++;
                 continue;
             }
-            if bitcast<f32>(texel_depth[tt.x]) < near {
+            let zx = bitcast<f32>(texel_depth[tt.x]);
+            if zx < near {
                 skipped++;
+                continue;
+            }
+            // The region at the texel's own depth (or the caster's deepest, if deeper).
+            let texel = tl.origin + vec2<i32>(i32(k % u32(TILE)), i32(k / u32(TILE)));
+            let at = max(zx, region.deepest);
+            if bounded && box_apart(region_box(&region, at), texel, 1) {
+                outside++;
+                continue;
+            }
+            if !tile_texel_in_hull(tl, k) {
                 continue;
             }
             visited++;
@@ -203,4 +261,5 @@ fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n:
     add64(8u, pairs);
     add64(10u, skipped);
     add64(13u, hidden);
+    add64(15u, outside);
 }

@@ -76,17 +76,29 @@ fn tile_texel_index(tl: Tile, k: u32) -> u32 {
 }
 
 // Texel `k` (0..64, row-major) of a tile: its index and the length of its list, 0 when it lies
-// outside the region's box or hull (empty lists are skipped, section 4.3).
-fn tile_texel(tl: Tile, k: u32) -> vec2<u32> {
+// outside the region's box (the hull is not tested).
+fn tile_texel_list(tl: Tile, k: u32) -> vec2<u32> {
     let tx = tl.origin.x + i32(k % u32(TILE));
     let ty = tl.origin.y + i32(k / u32(TILE));
     if tx < tl.first.x || ty < tl.first.y || tx > tl.last.x || ty > tl.last.y {
         return vec2<u32>(0u);
     }
     let texel = tile_texel_index(tl, k);
-    let len = offsets[texel + 1u] - offsets[texel];
-    if len == 0u || !texel_overlaps(tl.caster, tx, ty) {
-        return vec2<u32>(texel, 0u);
+    return vec2<u32>(texel, offsets[texel + 1u] - offsets[texel]);
+}
+
+// Whether texel `k` of a tile overlaps the caster's hull (conservative rasterisation).
+fn tile_texel_in_hull(tl: Tile, k: u32) -> bool {
+    return texel_overlaps(tl.caster, tl.origin.x + i32(k % u32(TILE)),
+                          tl.origin.y + i32(k / u32(TILE)));
+}
+
+// Texel `k` (0..64, row-major) of a tile: its index and the length of its list, 0 when it lies
+// outside the region's box or hull (empty lists are skipped, section 4.3).
+fn tile_texel(tl: Tile, k: u32) -> vec2<u32> {
+    let tt = tile_texel_list(tl, k);
+    if tt.y == 0u || !tile_texel_in_hull(tl, k) {
+        return vec2<u32>(tt.x, 0u);
     }
-    return vec2<u32>(texel, len);
+    return tt;
 }
