@@ -95,6 +95,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "pairs-one-sample",
         "texels-visited",
         "silhouette-edges",
+        "receiver-batches",
+        "receivers-listed",
         "tiles-culled",
         "texels-culled-by-depth",
         "pairs-after-umbra",
