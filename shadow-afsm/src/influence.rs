@@ -89,6 +89,11 @@ pub fn influence(caster: &Caster, b: &LightBounds, frame: &MapFrame) -> Influenc
     if v.iter().map(|p| (*p - c).dot(d)).fold(f32::MAX, f32::min) > far {
         return Influence::Culled;
     }
+    // Wholly before the light's nearest point along the axis (`influence.wgsl`).
+    let light_near = b.range(d).0 - d.dot(c);
+    if v.iter().map(|p| (*p - c).dot(d)).fold(f32::MIN, f32::max) < light_near - 1e-5 * far {
+        return Influence::Culled;
+    }
     let mut pts = Vec::new();
     for vk in v {
         let zv = (vk - c).dot(d);

@@ -112,11 +112,21 @@ fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n:
     let d = P.axis_d.xyz;
     let c = P.center.xyz;
     var zmin = 3.4e38;
+    var zmax = -3.4e38;
     for (var k = 0u; k < 3u; k++) {
         zmin = min(zmin, dot(v[k] - c, d));
+        zmax = max(zmax, dot(v[k] - c, d));
     }
     if zmin > zfar {
         // Beyond every listed view sample: it shadows none of them.
+        culled(t);
+        return;
+    }
+    // Wholly before the light's nearest point along the frustum axis (behind the light for
+    // this frustum, as for a cube face's frustum facing away from it): a segment from a view
+    // sample (in front of the light's centre) to the light never reaches it.
+    let light_near = (light_range(d) - dot(d, c)).x;
+    if zmax < light_near - 1e-5 * zfar {
         culled(t);
         return;
     }
