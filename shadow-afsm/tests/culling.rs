@@ -2,7 +2,8 @@
 //! same bit for every (view sample, light sample) pair, on scenes that exercise each of its
 //! tests (a room around the light for the supporting-plane test, a mesh on a floor for the
 //! depth and region tests, a sphere light whose far side lies beyond some view samples, a
-//! disk light, semi-opaque casters, and grass, where most view samples are hidden from every
+//! disk light, semi-opaque casters, a furnished room lit through a wall, whose view samples
+//! need one frustum per cube face, and grass, where most view samples are hidden from every
 //! light sample after the first range of casters and their texels drop out of later ranges),
 //! while testing fewer pairs.
 
@@ -28,6 +29,7 @@ fn cluster_culling_changes_no_bit_and_tests_fewer_pairs() {
         "semi-opaque",
         "large-light-close",
         "grass",
+        "interior-window",
     ] {
         let setup = builtin(name).unwrap();
         let view =
