@@ -11,12 +11,12 @@
 // `zt` instead of at the far plane (section 4.1's construction: the region grows
 // monotonically with depth). A tile beyond which the caster lies, or outside that smaller
 // region, gets no pairs (tally 9: tiles culled; tiles with no view sample, tally 12, get none
-// either); within a surviving tile, texels whose view samples all lie before the caster are
+// either). Within a surviving tile, texels whose view samples all lie before the caster are
 // skipped (tally 10), as are texels outside the region drawn at their own farthest depth
-// (tally 15), as are texels whose every view sample is already hidden from every
-// light sample by earlier ranges of casters (tally 13, `hidden.wgsl`; whole tiles, tally 14).
-// The tests are
-// conservative: they drop only pairs the occlusion test would find empty.
+// (tally 15). These tests are conservative: they drop only pairs the occlusion test would find
+// empty. Texels (tally 13) and whole tiles (tally 14) whose every view sample is already hidden
+// from every light sample by earlier ranges of casters (`hidden.wgsl`) are skipped as well:
+// their answer cannot change.
 //
 // Before that, the caster's supporting plane is tested against the tile's box of ray origins
 // and the light: when both lie strictly on one side, no segment between them crosses the
