@@ -140,6 +140,12 @@ pub(crate) fn device_error(e: GpuError) -> shadow_core::technique::TechniqueErro
     shadow_core::technique::TechniqueError::Device(e.to_string())
 }
 
+/// Consecutive pairs each occlusion invocation takes, for `words` words of sample bits per view
+/// sample (`pairs_per_invocation` in `occlude.wgsl`, which the dispatch size must match).
+fn pairs_per_invocation(words: u32) -> u32 {
+    (64 / words.max(1)).clamp(1, 8)
+}
+
 /// Runs phase `name` of `stats` (wall-clock time from submission to completion, readbacks
 /// included) and, where the device has timestamp queries, adds the device time of its passes
 /// to counter `name-device-ns` (a counter, not a phase, so phase totals stay wall-clock).
@@ -269,11 +275,6 @@ struct Occlusion<'a> {
 }
 
 impl Occlusion<'_> {
-    /// Words of sample bits per view sample.
-    fn shared_words(&self, params: &Params) -> u32 {
-        params.dims[3].max(1)
-    }
-
     /// Reads the 64-bit tally `slot`.
     fn tally(&self, slot: usize) -> Result<u64, GpuError> {
         let t: Vec<u32> = self.gpu.read(self.tallies, TALLY_WORDS)?;
@@ -469,9 +470,7 @@ impl Occlusion<'_> {
             return Ok(());
         }
         p.work[3] = pairs as u32;
-        // Pairs per invocation as `pairs_per_invocation` in `occlude.wgsl` deals them.
-        let per_invocation = (64 / self.shared_words(&params)).clamp(1, 8) as u64;
-        let groups = pairs.div_ceil(64 * per_invocation);
+        let groups = pairs.div_ceil(64 * pairs_per_invocation(params.dims[3]) as u64);
         timed(gpu, stats, "gpu-occlude", || {
             let uni = gpu.uniform("params", &p);
             let mut enc = gpu.encoder();
