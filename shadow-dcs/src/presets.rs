@@ -17,7 +17,7 @@
 use shadow_core::prelude::*;
 
 use crate::budgets;
-use crate::{CoveredSamples, Dcs, Silhouettes};
+use crate::{CoveredSamples, Dcs, RayChoice, Silhouettes};
 
 /// A preset's DCS; its fixed sample counts are in the sampler's range.
 fn make(samples: u32, strategy: SamplingStrategy, seed: u64) -> Dcs {
@@ -104,6 +104,26 @@ pub fn presets() -> Vec<Preset> {
                  times the occluder one cell is wider than the projected occluder; the exact and \
                  refined modes hold",
             )],
+        },
+        Preset {
+            name: "dcs-64-hybrid",
+            description: "DCS, 64 stratified samples, exact covered samples; squares where shadow rays cost less are traced on the same samples",
+            make: |seed| {
+                Box::new(
+                    make(64, SamplingStrategy::Stratified, seed)
+                        .with_rays(RayChoice::default())
+                        .named("dcs-64-hybrid"),
+                )
+            },
+            budget: |s| exact_budget(64, budgets::DCS_64_SEMI, s),
+            with_samples: Some(|n, seed| {
+                Ok(Box::new(
+                    Dcs::new(n, SamplingStrategy::Stratified, seed)?
+                        .with_rays(RayChoice::default())
+                        .named(&format!("dcs-hybrid-{n}")),
+                ))
+            }),
+            known_limitations: &[],
         },
         Preset {
             name: "dcs-256",

@@ -43,4 +43,4 @@ pub mod wide;
 
 pub use adaptive::AdaptiveReference;
 pub use presets::presets;
-pub use reference::{PreparedReference, Reference};
+pub use reference::{PixelScratch, PreparedReference, Reference};

@@ -66,6 +66,10 @@ pub(crate) struct Scratch {
     candidates: BeamCandidates,
 }
 
+/// Per-thread buffers of [`PreparedReference::pixel_visibility`], reused across its calls.
+#[derive(Default)]
+pub struct PixelScratch(Scratch);
+
 /// What a receiver's beam found.
 pub(crate) struct ReceiverBeam {
     origin: Vec3,
@@ -533,6 +537,25 @@ impl PreparedReference {
     /// The BVH.
     pub fn bvh(&self) -> &OcclusionBvh {
         &self.p.bvh
+    }
+
+    /// The visibility of each of `samples` (any sampler's light samples, in order) from view
+    /// sample `s`, found exactly as [`PreparedShadows::estimate`] finds it for the same samples
+    /// (the receiver's beam, its candidate list or the BVH segment by segment): per sample 1 or
+    /// 0 (the transmittance in `[0, 1]` on semi-opaque scenes), 0 below the receiver's horizon.
+    /// Returns the visibilities (in `scratch`) and the segments traced. Other techniques use it
+    /// to hand the pixels where rays cost less than their own work to the reference, with the
+    /// same answers.
+    pub fn pixel_visibility<'a>(
+        &self,
+        s: &ViewSample,
+        samples: &[LightSample],
+        scratch: &'a mut PixelScratch,
+    ) -> (&'a [f32], u64) {
+        let c = &self.config;
+        let rb = c.receiver_beam(&self.p, s, samples.len(), &mut scratch.0);
+        let counts = c.sample_visibility(&self.p, s, &rb, samples, &mut scratch.0);
+        (&scratch.0.vis, counts.rays)
     }
 
     /// The occlusion segment from view sample `s` to light sample `y`: robust origin, unit

@@ -7,13 +7,16 @@ use super::pixel::PixelPass;
 use super::*;
 
 impl Dcs {
-    /// Everything per frame before the per-pixel pass.
-    pub(super) fn frame<'a>(
+    /// Everything per frame before the per-pixel pass: the view samples' origins and horizons,
+    /// the squares with their wedges and where each square's visibility comes from (the plan),
+    /// and the integration constants of the pixels DCS estimates.
+    pub(super) fn frame<'a, 'p>(
         &self,
-        p: &Prepared,
+        p: &'p Prepared,
         view: &'a ViewSamples,
+        traceable: bool,
         stats: &mut Stats,
-    ) -> Result<Frame<'a>, TechniqueError> {
+    ) -> Result<(Frame<'a>, Plan<'p>), TechniqueError> {
         let eye = view.eye().ok_or_else(|| {
             TechniqueError::unsupported(
                 &self.name,
@@ -41,6 +44,50 @@ impl Dcs {
             .par_iter()
             .map(|o| (o.as_dvec3() - cd).as_vec3())
             .collect();
+        let planar_ok = match (&p.planar, self.covered) {
+            (Some(pl), CoveredSamples::Exact) => centred
+                .par_iter()
+                .zip(&active)
+                .map(|(x, a)| *a && x.dot(pl.normal).abs() > NEAR_PLANE * x.length())
+                .collect(),
+            _ => Vec::new(),
+        };
+        stats.add("wedges", p.scan.len() as u64);
+        let mut f = Frame {
+            origins,
+            centred,
+            horizon,
+            active,
+            constants: Vec::new(),
+            planar_ok,
+            bits: 0,
+            view,
+        };
+        let plan = stats.time("square-plan", || self.plan(p, &f, traceable));
+        self.integration_constants(p, &mut f, &plan, eye, stats);
+        Ok((f, plan))
+    }
+
+    /// The integration constant `D(p, c)` of every view sample (section 4.1: the shadow-volume
+    /// step; none when `plan` traces the frame) and the counter width from the largest
+    /// (section 5.3).
+    fn integration_constants(
+        &self,
+        p: &Prepared,
+        f: &mut Frame,
+        plan: &Plan,
+        eye: Vec3,
+        stats: &mut Stats,
+    ) {
+        let c = p.shape.center;
+        if plan.reference.is_some() {
+            // The frame is traced: no shadow volume is needed.
+            stats.add("shadow-volumes-skipped", 1);
+            f.constants = vec![0; f.active.len()];
+            f.bits = self.forced_bits.unwrap_or_else(|| width_for(0));
+            return;
+        }
+        let (origins, centred, view) = (&f.origins, &f.centred, f.view);
         let (constants, quads) = stats.time("shadow-volumes", || {
             let eye_c = eye_constant(p.scene.as_ref(), p.units, eye, c);
             integration_constants(
@@ -50,41 +97,24 @@ impl Dcs {
                 eye,
                 eye_c,
                 view.raster_view(),
-                &origins,
-                &centred,
-                &active,
+                origins,
+                centred,
+                &f.active,
             )
         });
         stats.add("shadow-volume-quads", quads);
         let max_constant = constants.par_iter().copied().max().unwrap_or(0).max(0) as u64;
-        let bits = self.forced_bits.unwrap_or_else(|| width_for(max_constant));
+        f.bits = self.forced_bits.unwrap_or_else(|| width_for(max_constant));
+        f.constants = constants;
         stats.gauge_max("max-integration-constant", max_constant);
-        stats.gauge_max("counter-bits", bits as u64);
-        stats.add("wedges", p.scan.len() as u64);
-        let planar_ok = match (&p.planar, self.covered) {
-            (Some(pl), CoveredSamples::Exact) => centred
-                .par_iter()
-                .zip(&active)
-                .map(|(x, a)| *a && x.dot(pl.normal).abs() > NEAR_PLANE * x.length())
-                .collect(),
-            _ => Vec::new(),
-        };
-        Ok(Frame {
-            origins,
-            centred,
-            horizon,
-            active,
-            constants,
-            planar_ok,
-            bits,
-            view,
-        })
+        stats.gauge_max("counter-bits", f.bits as u64);
     }
 
-    /// Runs the per-pixel pass over the square `rect`: its wedge pairs (from the wedges its box
-    /// keeps, `wedges`), then every view sample, handed to `visit` with its class and the
-    /// scratch holding its visible samples and, with `values`, its samples' visibilities and
-    /// depth complexities.
+    /// Runs the per-pixel pass over the square of `job`: its wedge pairs (from the wedges its
+    /// box keeps), then every view sample, handed to `visit` with its class and the scratch
+    /// holding its visible samples and, with `values`, its samples' visibilities and depth
+    /// complexities. A square the plan traces takes the same from shadow rays on the same
+    /// samples instead (no depth complexities).
     #[expect(
         clippy::too_many_arguments,
         reason = "the per-pixel pass hands its prepared data, frame, pixel, scratch and counters down the hot path"
@@ -93,8 +123,8 @@ impl Dcs {
         &self,
         p: &Prepared,
         f: &Frame,
-        wedges: &[u32],
-        rect: Rect,
+        plan: &Plan,
+        job: &Job,
         values: bool,
         counts: &mut Counts,
         buffers: &mut SquareBuffers,
@@ -107,7 +137,18 @@ impl Dcs {
             scratch,
         } = buffers;
         scratch.want_values = values;
-        square_pairs(&Self::scan_input(p, f), wedges, rect, pairs, scan);
+        if let Some(reference) = plan.reference {
+            counts.traced_squares += 1;
+            let w = view.width();
+            for i in job.rect.pixels(w) {
+                let (x, y) = ((i % w as usize) as u32, (i / w as usize) as u32);
+                let Some(s) = view.get_at(x, y) else { continue };
+                let class = self.ray_pixel(p, reference, f, i, &s, scratch, counts);
+                visit(i, &s, class, scratch);
+            }
+            return;
+        }
+        square_pairs(&Self::scan_input(p, f), &job.wedges, job.rect, pairs, scan);
         counts.scan.add(&pairs.counts);
         counts.pairs += pairs.len() as u64;
         let w = view.width() as usize;
@@ -145,58 +186,58 @@ impl Dcs {
         }
     }
 
-    /// Runs `work` on every square of the view in parallel, with the wedges its box keeps (the
-    /// box hierarchy of [`crate::accel::bins`]: blocks, then their squares). Returns each square's
-    /// result and the number of (block, wedge) pairs kept.
-    pub(super) fn squares<T: Send>(
-        &self,
-        p: &Prepared,
-        f: &Frame,
-        work: impl Fn(Rect, &[u32], &mut SquareBuffers) -> T + Sync + Send,
-    ) -> (Vec<(Rect, T)>, u64) {
+    /// The squares of the view with the wedges each keeps (the box hierarchy of
+    /// [`crate::accel::bins`]: blocks, then their squares), and the number of (block, wedge)
+    /// pairs kept.
+    pub(super) fn square_lists(&self, p: &Prepared, f: &Frame) -> (Vec<(Rect, Vec<u32>)>, u64) {
         let view = f.view;
         let input = Self::scan_input(p, f);
         let blocks = crate::accel::bins::blocks(view.width(), view.height());
         let levels = BlockWedges::new(&input, &blocks);
-        // Every block's square lists first, then all squares of the view as one parallel
-        // loop: a block boundary is no barrier, so a thread that runs out of work steals any
-        // square left, not only those of the block it is in.
         let lists: Vec<(Vec<Vec<u32>>, usize)> = blocks
             .par_iter()
             .enumerate()
             .map(|(bi, (_, squares))| levels.square_lists(&input, bi, squares))
             .collect();
         let kept = lists.iter().map(|(_, k)| *k as u64).sum();
-        let jobs: Vec<(Rect, &[u32])> = blocks
+        let jobs = blocks
             .iter()
-            .zip(&lists)
-            .flat_map(|((_, squares), (l, _))| {
-                squares.iter().copied().zip(l.iter().map(Vec::as_slice))
-            })
+            .zip(lists)
+            .flat_map(|((_, squares), (l, _))| squares.iter().copied().zip(l))
             .collect();
+        (jobs, kept)
+    }
+
+    /// Runs `work` on every square of `plan` in parallel (a block boundary is no barrier: every
+    /// square of the view is one parallel loop, so a thread that runs out of work steals any
+    /// square left, not only those of the block it is in). Returns each square's result.
+    pub(super) fn squares<T: Send>(
+        &self,
+        plan: &Plan,
+        work: impl Fn(&Job, &mut SquareBuffers) -> T + Sync + Send,
+    ) -> Vec<(Rect, T)> {
         // One square per job: a square's cost ranges from nothing to milliseconds (the
         // penumbra gathers in a few of them), and rayon's own split of the list left one
         // thread on a run of 128 costly squares while the other idled (on `bunny`, a thread
         // busy 90 ms of the pass's 164 ms). The buffers go back to a pool after each square,
         // since a job per square would otherwise start from empty buffers every time.
         let pool = Mutex::new(Vec::<SquareBuffers>::new());
-        let out = jobs
+        plan.jobs
             .par_iter()
             .with_max_len(1)
-            .map(|&(r, list)| {
+            .map(|job| {
                 let mut buffers = pool
                     .lock()
                     .ok()
                     .and_then(|mut p| p.pop())
                     .unwrap_or_default();
-                let done = work(r, list, &mut buffers);
+                let done = work(job, &mut buffers);
                 if let Ok(mut p) = pool.lock() {
                     p.push(buffers);
                 }
-                (r, done)
+                (job.rect, done)
             })
-            .collect();
-        (out, kept)
+            .collect()
     }
 
     /// Direct illumination of every view sample by DCS eq. 6: the light samples' contributions
@@ -210,9 +251,9 @@ impl Dcs {
         view: &ViewSamples,
     ) -> Result<Vec<Vec3>, TechniqueError> {
         let mut stats = Stats::default();
-        let f = self.frame(p, view, &mut stats)?;
-        let (parts, _) = self.squares(p, &f, |rect, block, buffers| {
-            let mut out = Vec::with_capacity(rect.len());
+        let (f, plan) = self.frame(p, view, true, &mut stats)?;
+        let parts = self.squares(&plan, |job, buffers| {
+            let mut out = Vec::with_capacity(job.rect.len());
             let mut counts = Counts::default();
             let mut units = Vec::new();
             let mut samples = Vec::new();
@@ -220,8 +261,8 @@ impl Dcs {
             self.run_square(
                 p,
                 &f,
-                block,
-                rect,
+                &plan,
+                job,
                 true,
                 &mut counts,
                 buffers,
@@ -319,6 +360,7 @@ impl Dcs {
             .unzip();
         let offset = RayOffset::for_light(&*light);
         let p = Prepared {
+            rays: self.rays.map(|_| RayPath::default()),
             planar,
             rect,
             scan,
@@ -350,7 +392,8 @@ impl Dcs {
         output: PerSampleOutput,
     ) -> Result<Estimate, TechniqueError> {
         let mut stats = Stats::default();
-        let f = self.frame(p, view, &mut stats)?;
+        // Rays give no depth complexities: a frame whose counters are read is DCS's alone.
+        let (f, plan) = self.frame(p, view, output != PerSampleOutput::Counters, &mut stats)?;
         let n = self.sampler.count() as usize;
         let words = n.div_ceil(64);
         let w = view.width() as usize;
@@ -363,8 +406,9 @@ impl Dcs {
             depth: Vec<u32>,
             counts: Counts,
         }
-        let (strips, block_wedges) = stats.time("depth-complexity", || {
-            self.squares(p, &f, |rect, block, buffers| {
+        let strips = stats.time("depth-complexity", || {
+            self.squares(&plan, |job, buffers| {
+                let rect = job.rect;
                 let m = rect.len();
                 let rw = rect.width() as usize;
                 let mut r = Row {
@@ -394,8 +438,8 @@ impl Dcs {
                 self.run_square(
                     p,
                     &f,
-                    block,
-                    rect,
+                    &plan,
+                    job,
                     values,
                     &mut counts,
                     buffers,
@@ -528,7 +572,17 @@ impl Dcs {
         stats.add("edge-ties", counts.ties + counts.scan.ties);
         stats.add("wedge-pixels-scanned", counts.scan.scanned);
         stats.add("wedge-exact-weights", counts.scan.exact_weights);
-        stats.add("bin-block-wedges", block_wedges);
+        stats.add("bin-block-wedges", plan.block_wedges);
+        stats.add("squares-traced", counts.traced_squares);
+        if let Some([dcs, volumes, rays, bvh]) = plan.predicted {
+            // Whole rays: the predictions are far below u64's range.
+            stats.add("predicted-dcs-rays", dcs as u64);
+            stats.add("predicted-shadow-volume-rays", volumes as u64);
+            stats.add("predicted-traced-rays", rays as u64);
+            stats.add("predicted-bvh-rays", bvh as u64);
+        }
+        stats.add("pixels-traced", counts.traced_pixels);
+        stats.add("occlusion-rays", counts.rays);
         stats.add("bin-square-wedges", counts.scan.square_wedges);
         stats.add("bin-tile-wedges", counts.scan.tile_wedges);
         stats.add("wedge-pairs", counts.pairs);

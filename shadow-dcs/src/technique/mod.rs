@@ -65,6 +65,10 @@ use crate::stages::wedges::{FOLD_SLACK, Pair};
 
 mod frame;
 mod pixel;
+mod rays;
+
+pub use rays::RayChoice;
+use rays::{Job, Plan, RayPath};
 
 /// What per-sample visibility an estimate returns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -102,6 +106,8 @@ struct Prepared {
     /// A constant rectangle light's half sides on the light plane's axes: its samples' plane
     /// coordinates come straight from the unit samples.
     rect: Option<RectMap>,
+    /// The shadow-ray side of a hybrid ([`rays`]); `None` for DCS alone.
+    rays: Option<RayPath>,
 }
 
 /// A planar light's frame, for the light-plane test ([`crate::accel::planar`]).
@@ -124,6 +130,9 @@ pub struct Dcs {
     /// Whether pixels of one shared sample set share its set-up ([`crate::accel::shared_sets`]);
     /// off only in tests, which check the shared set-up against each pixel's own.
     share_sets: bool,
+    /// Squares where rays are predicted to cost less go to the reference on the same samples
+    /// ([`rays`]); `None`: DCS everywhere.
+    rays: Option<RayChoice>,
 }
 
 /// DCS prepared for one scene and light: its edges, silhouettes, wedges and tables.
@@ -195,6 +204,42 @@ enum Horizon {
     Grazing,
     Below,
     Mixed,
+}
+
+/// The class of a pixel from its samples' visibilities, taken one by one, with the visible
+/// samples marked on the way.
+struct ClassTally {
+    lit: bool,
+    dark: bool,
+}
+
+impl ClassTally {
+    fn new() -> Self {
+        Self {
+            lit: true,
+            dark: true,
+        }
+    }
+
+    /// Sample `k` has visibility `v`; a visible one (1) is set in `visible`.
+    #[inline]
+    fn add(&mut self, k: usize, v: f32, visible: &mut [u64]) {
+        self.lit &= v == 1.0;
+        self.dark &= v == 0.0;
+        if v == 1.0 {
+            visible[k / 64] |= 1 << (k % 64);
+        }
+    }
+
+    fn class(&self) -> PixelClass {
+        if self.lit {
+            PixelClass::Lit
+        } else if self.dark {
+            PixelClass::Umbra
+        } else {
+            PixelClass::Penumbra
+        }
+    }
 }
 
 /// What a pixel's pass keeps from its start to its end.
@@ -286,6 +331,31 @@ struct Scratch {
     visible: Vec<u64>,
     depth: Vec<u64>,
     vis: Vec<f32>,
+    /// The reference's buffers, for traced pixels.
+    rays: shadow_ref::PixelScratch,
+}
+
+impl Scratch {
+    /// Empties the per-pixel buffers for a pixel of `n` samples. A pixel facing away from the
+    /// whole light (`below`) is counted and gets its values at once (every sample hidden, below
+    /// the horizon): returns false for it.
+    fn begin_pixel(&mut self, n: usize, below: bool, counts: &mut Counts) -> bool {
+        self.vis.clear();
+        self.depth.clear();
+        self.samples.clear();
+        self.radiances.clear();
+        self.visible.clear();
+        self.visible.resize(n.div_ceil(64), 0);
+        self.updates.clear();
+        if below {
+            counts.facing_away += 1;
+            if self.want_values {
+                self.vis.resize(n, 0.0);
+                self.depth.resize(n, u64::MAX);
+            }
+        }
+        !below
+    }
 }
 
 /// Per-thread buffers of a square: its pairs, the scan's buffers, and the pixels' scratch (kept
@@ -317,6 +387,10 @@ struct Counts {
     shared_sets_built: u64,
     sector_empty: u64,
     line_cells: u64,
+    /// Squares and pixels traced with shadow rays, and the rays.
+    traced_squares: u64,
+    traced_pixels: u64,
+    rays: u64,
 }
 
 impl Counts {
@@ -337,6 +411,9 @@ impl Counts {
         self.shared_sets_built += o.shared_sets_built;
         self.sector_empty += o.sector_empty;
         self.line_cells += o.line_cells;
+        self.traced_squares += o.traced_squares;
+        self.traced_pixels += o.traced_pixels;
+        self.rays += o.rays;
     }
 }
 
@@ -359,6 +436,7 @@ impl Dcs {
             output: PerSampleOutput::Bits,
             forced_bits: None,
             share_sets: true,
+            rays: None,
         })
     }
 
@@ -404,6 +482,17 @@ impl Dcs {
     #[must_use]
     pub fn with_counter_bits(mut self, bits: u32) -> Self {
         self.forced_bits = Some(bits);
+        self
+    }
+
+    /// Traces with shadow rays, on the same samples, the squares where `choice` predicts rays
+    /// cost less than DCS ([`RayChoice`]): the same answers (up to numerical ties) for less
+    /// work on dense meshes under large lights. Opaque scenes only (on semi-opaque ones the
+    /// saturating opacity sum of section 3 is not what rays compute), and never when depth
+    /// complexities are asked for.
+    #[must_use]
+    pub fn with_rays(mut self, choice: RayChoice) -> Self {
+        self.rays = Some(choice);
         self
     }
 

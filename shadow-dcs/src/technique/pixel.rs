@@ -110,19 +110,7 @@ impl PixelPass<'_, '_> {
         let (scratch, counts) = (&mut *self.scratch, &mut *self.counts);
         let n = dcs.sampler.count() as usize;
         let horizon = f.horizon[i];
-        scratch.vis.clear();
-        scratch.depth.clear();
-        scratch.samples.clear();
-        scratch.radiances.clear();
-        scratch.visible.clear();
-        scratch.visible.resize(n.div_ceil(64), 0);
-        scratch.updates.clear();
-        if horizon == Horizon::Below {
-            counts.facing_away += 1;
-            if scratch.want_values {
-                scratch.vis.resize(n, 0.0);
-                scratch.depth.resize(n, u64::MAX);
-            }
+        if !scratch.begin_pixel(n, horizon == Horizon::Below, counts) {
             return None;
         }
         let mut d0 = f.constants[i];
@@ -252,7 +240,7 @@ impl PixelPass<'_, '_> {
                 .depth
                 .extend(scratch.plain.iter().map(|&d| d.max(0) as u64));
         }
-        let (mut lit, mut dark) = (true, true);
+        let mut tally = ClassTally::new();
         // One unit per occluder (no semi-opaque scene): the visibility is whether the depth
         // complexity is 0, as the general expression gives it.
         let whole = units == 1.0;
@@ -268,20 +256,10 @@ impl PixelPass<'_, '_> {
                 scratch.depth[k] = u64::MAX;
                 0.0
             };
-            lit &= v == 1.0;
-            dark &= v == 0.0;
-            if v == 1.0 {
-                scratch.visible[k / 64] |= 1 << (k % 64);
-            }
+            tally.add(k, v, &mut scratch.visible);
             scratch.vis.push(v);
         }
-        if lit {
-            PixelClass::Lit
-        } else if dark {
-            PixelClass::Umbra
-        } else {
-            PixelClass::Penumbra
-        }
+        tally.class()
     }
 
     /// A per-sample pixel's samples: positions, the horizon mask, the samples relative to the

@@ -274,6 +274,34 @@ pub(crate) struct ScanInput<'a> {
     pub planar: Option<(&'a [CentredEdge], &'a [bool])>,
 }
 
+/// The (tile, wedge) candidates of square `rect` among `wedges` (silhouette indices): the
+/// pairs whose boxes meet, which [`square_pairs`] then evaluates on the tile's view samples
+/// (its `tile_wedges` count), found by the box tests alone: all of them for lists of up to
+/// `most` wedges, else an evenly spaced sample of `most` scaled to the whole list. The hybrid's
+/// cost predictor (`technique::rays`): a square's DCS work follows it.
+pub(crate) fn square_tile_wedges(
+    input: &ScanInput,
+    wedges: &[u32],
+    rect: Rect,
+    most: usize,
+    scratch: &mut SquareScratch,
+) -> f64 {
+    if wedges.is_empty() {
+        return 0.0;
+    }
+    let tiles = &mut scratch.tiles;
+    tiles.set(input, rect);
+    let step = wedges.len().div_ceil(most.max(1));
+    let (met, tested) = wedges
+        .iter()
+        .step_by(step)
+        .fold((0u64, 0u64), |(met, tested), &wi| {
+            let mask = tiles.boxes.test(&input.wedges[wi as usize], input.slack);
+            (met + u64::from(mask.count_ones()), tested + 1)
+        });
+    met as f64 * wedges.len() as f64 / tested as f64
+}
+
 /// The pairs of square `rect` from the wedges its box keeps (`wedges`, silhouette indices in
 /// order), wedge by wedge: its box test against the square's tiles, then on the view samples of
 /// each tile it keeps (fold planes, bounding planes, then the weight, exact where the
