@@ -100,6 +100,19 @@ fn the_measured_choice_traces_grass_and_not_bunny() {
         assert!(m.sample_agreement.unwrap() >= 0.9999, "{scene}: {m:?}");
         let squares = h.stats.counter("squares-traced").unwrap();
         assert_eq!(squares > 0, traced, "{scene}: {squares} squares traced");
+        // The choice weighed what it says: DCS's predicted work against the rays and the BVH.
+        let c = |k: &str| h.stats.counter(k).unwrap();
+        let dcs_work = c("predicted-dcs-rays") + c("predicted-shadow-volume-rays");
+        let rays = c("predicted-traced-rays") + c("predicted-bvh-rays");
+        assert_eq!(
+            rays < dcs_work,
+            traced,
+            "{scene}: {dcs_work} against {rays}"
+        );
+        assert_eq!(
+            dcs.parameters()["rays"]["rays_per_candidate"],
+            serde_json::json!(RayChoice::default().rays_per_candidate),
+        );
     }
 }
 

@@ -593,6 +593,13 @@ impl ShadowTechnique for Dcs {
             "seed": self.sampler.seed(),
             "silhouettes": format!("{:?}", self.detection),
             "covered_samples": format!("{:?}", self.covered),
+            // The hybrid's costs (in rays), so that a report says what the choice weighed.
+            "rays": self.rays.map(|c| json!({
+                "rays_per_candidate": c.rays_per_candidate,
+                "per_further_word": c.per_further_word,
+                "rays_per_shadow_volume": c.rays_per_shadow_volume,
+                "rays_per_bvh_triangle": c.rays_per_bvh_triangle,
+            })),
         })
     }
 
