@@ -12,9 +12,9 @@
 //! The prediction reads what the box hierarchy knows before the scan: the (tile, wedge)
 //! candidates whose boxes meet, which the scan would evaluate on the tiles' view samples,
 //! counted on an evenly spaced sample of the squares (and of each one's wedges) and scaled to
-//! the frame; against them, one ray per light sample of
-//! every active pixel, the reference's BVH unless already built, and the shadow-volume pass
-//! (section 4.1) that a traced frame skips. Costs are in rays ([`RayChoice`]), measured.
+//! the frame; against them, one ray per light sample of every active pixel, the reference's
+//! BVH unless already built, and the shadow-volume pass (section 4.1) that a traced frame
+//! skips. Costs are in rays ([`RayChoice`]), measured.
 //!
 //! A choice per square was built and measured first (`docs/history/dcs-hybrid-2026-12-07.md`):
 //! the per-square predictions err by several times either way, so mixed frames traced
@@ -31,8 +31,8 @@ use shadow_ref::{PreparedReference, Reference};
 use super::*;
 use crate::accel::bins::{SquareScratch, square_tile_wedges};
 
-/// When a square is traced rather than estimated by DCS: the predicted costs of each side,
-/// in units of one shadow ray.
+/// When a frame is traced rather than estimated by DCS: the predicted costs of each side, in
+/// units of one shadow ray.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RayChoice {
     /// DCS's work per (tile, wedge) candidate of a square (of the wedge scan's box hierarchy:
@@ -50,7 +50,7 @@ pub struct RayChoice {
 }
 
 impl RayChoice {
-    /// Every square traced, whatever it costs (tests: the ray path alone).
+    /// Every frame traced, whatever it costs (tests: the ray path alone).
     pub const EVERYWHERE: Self = Self {
         rays_per_candidate: f32::INFINITY,
         per_further_word: 0.0,
@@ -93,17 +93,16 @@ pub(super) struct RayPath {
 }
 
 impl RayPath {
-    /// The reference on `dcs`'s samples for `p`'s scene and light (`None` when it cannot take
-    /// them, which never happens for the scenes DCS takes), and whether this call built it.
-    fn reference(&self, dcs: &Dcs, p: &Prepared) -> (Option<&PreparedReference>, bool) {
-        let mut built = false;
-        let r = self.reference.get_or_init(|| {
-            built = true;
-            Reference::same_samples(dcs.sampler.clone())
-                .prepare_reference(p.scene.clone(), p.light.clone())
-                .ok()
-        });
-        (r.as_ref(), built)
+    /// The reference on `dcs`'s samples for `p`'s scene and light, built on the first call
+    /// (`None` when it cannot take them, which never happens for the scenes DCS takes).
+    fn get_or_build(&self, dcs: &Dcs, p: &Prepared) -> Option<&PreparedReference> {
+        self.reference
+            .get_or_init(|| {
+                Reference::same_samples(dcs.sampler.clone())
+                    .prepare_reference(p.scene.clone(), p.light.clone())
+                    .ok()
+            })
+            .as_ref()
     }
 }
 
@@ -171,7 +170,7 @@ impl Dcs {
             / probed.len().max(1) as f64;
         plan.predicted = Some([dcs, volumes, rays, bvh]);
         if choice == RayChoice::EVERYWHERE || rays + bvh < dcs + volumes {
-            plan.reference = path.reference(self, p).0;
+            plan.reference = path.get_or_build(self, p);
         }
         plan
     }
