@@ -39,11 +39,12 @@ pub mod light_frame;
 pub mod light_space;
 pub mod light_view;
 mod presets;
+pub mod rect_union;
 pub mod screen_space;
 pub mod shadow_map;
 pub mod technique;
 
 pub use light_space::Contours;
-pub use presets::presets;
+pub use presets::{PEELING_MAX_BIAS, presets};
 pub use screen_space::ScreenSpace;
 pub use technique::{Filter, ShadowMapFilter};

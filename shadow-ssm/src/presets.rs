@@ -56,6 +56,7 @@ pub fn presets() -> Vec<Preset> {
                         max_nspp: 1024,
                         gap_filling: true,
                         peeling_max_bias: None,
+                        union: false,
                     }),
                     RESOLUTION,
                 ))
@@ -72,7 +73,7 @@ pub fn presets() -> Vec<Preset> {
         },
         Preset {
             name: "ssm-peeling",
-            description: "Soft shadow mapping with 3 depth-peeled layers and midpoint depths (BCS06 section 4), no gap filling, 1024^2 map",
+            description: "Soft shadow mapping with 3 depth-peeled layers and midpoint depths (BCS06 section 4), every occluding layer's back-projection united over the light (not summed), no gap filling, 1024^2 map",
             make: |_| {
                 Box::new(ShadowMapFilter::new(
                     "ssm-peeling",
@@ -80,6 +81,7 @@ pub fn presets() -> Vec<Preset> {
                         max_nspp: 1024,
                         gap_filling: false,
                         peeling_max_bias: Some(PEELING_MAX_BIAS),
+                        union: true,
                     }),
                     RESOLUTION,
                 ))

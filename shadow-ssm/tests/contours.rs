@@ -44,6 +44,7 @@ fn backprojection() -> Filter {
         max_nspp: 1024,
         gap_filling: true,
         peeling_max_bias: None,
+        union: false,
     })
 }
 
