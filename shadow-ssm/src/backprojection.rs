@@ -25,7 +25,7 @@
 use glam::DVec2;
 
 use crate::light_domain::{Covered, LightDomain};
-use crate::rect_union::{UnionScratch, disjoint_pieces};
+use crate::rect_union::{UnionScratch, disjoint_strips};
 use crate::shadow_map::ShadowMap;
 
 /// Settings of one back-projection.
@@ -171,11 +171,9 @@ impl Backprojection {
             iy += step;
         }
         if self.union {
-            let mut pieces = Vec::new();
-            disjoint_pieces(&found, &mut UnionScratch::default(), &mut pieces);
-            for (lo, hi) in pieces {
-                sum += light.rect(lo, hi);
-            }
+            disjoint_strips(&found, &mut UnionScratch::default(), |x0, x1, ys| {
+                sum += light.strip(x0, x1, ys);
+            });
         }
         (sum, read)
     }

@@ -50,6 +50,10 @@ impl std::ops::SubAssign for Covered {
 pub struct LightDomain {
     points: Vec<DVec2>,
     area: f64,
+    /// The outline's bounding box, and whether the outline is that box (a rectangle light
+    /// whose sides follow the map's axes): its rectangles are then clipped by two comparisons.
+    bounds: (DVec2, DVec2),
+    is_box: bool,
     texture: Option<RadianceTable>,
     full: Covered,
 }
@@ -59,7 +63,14 @@ impl LightDomain {
     pub fn new(points: &[Vec2]) -> Self {
         let points: Vec<DVec2> = points.iter().map(|p| p.as_dvec2()).collect();
         let area = polygon_area(&points).abs();
+        let lo = points.iter().copied().fold(DVec2::INFINITY, DVec2::min);
+        let hi = points.iter().copied().fold(DVec2::NEG_INFINITY, DVec2::max);
+        let box_area = (hi - lo).x * (hi - lo).y;
+        // A convex outline with its bounding box's area is that box.
+        let is_box = area > 0.0 && (box_area - area).abs() <= 1e-12 * box_area;
         Self {
+            bounds: (lo, hi),
+            is_box,
             full: Covered {
                 area,
                 radiance: DVec3::ZERO,
@@ -128,13 +139,78 @@ impl LightDomain {
         poly
     }
 
+    /// The area of a box outline inside `lo..hi`, when the outline is a box.
+    fn box_overlap(&self, lo: DVec2, hi: DVec2) -> Option<f64> {
+        if !self.is_box {
+            return None;
+        }
+        let (a, b) = (lo.max(self.bounds.0), hi.min(self.bounds.1));
+        Some(if a.x < b.x && a.y < b.y {
+            (b.x - a.x) * (b.y - a.y)
+        } else {
+            0.0
+        })
+    }
+
     /// The light inside the axis-aligned rectangle `lo..hi`.
     pub fn rect(&self, lo: DVec2, hi: DVec2) -> Covered {
+        if self.texture.is_none()
+            && let Some(area) = self.box_overlap(lo, hi)
+        {
+            return Covered {
+                area,
+                radiance: DVec3::ZERO,
+            };
+        }
         self.covered(&self.clip_rect(lo, hi))
+    }
+
+    /// The light inside the rectangles `x0..x1` by each of the disjoint intervals `ys`: the
+    /// light is clipped to the strip once, then to each interval.
+    pub fn strip(&self, x0: f64, x1: f64, ys: &[(f64, f64)]) -> Covered {
+        let mut sum = Covered::default();
+        if self.texture.is_none() && self.is_box {
+            for &(y0, y1) in ys {
+                sum.area += self
+                    .box_overlap(DVec2::new(x0, y0), DVec2::new(x1, y1))
+                    .unwrap_or(0.0);
+            }
+            return sum;
+        }
+        if !(x0 < x1) {
+            return sum;
+        }
+        let mut strip = self.points.clone();
+        let mut scratch = Vec::with_capacity(strip.len() + 4);
+        for (n, c) in [(DVec2::X, x0), (DVec2::NEG_X, -x1)] {
+            clip(&mut strip, &mut scratch, n, c);
+            if strip.len() < 3 {
+                return sum;
+            }
+        }
+        let mut poly = Vec::with_capacity(strip.len() + 2);
+        for &(y0, y1) in ys {
+            if !(y0 < y1) {
+                continue;
+            }
+            poly.clear();
+            poly.extend_from_slice(&strip);
+            for (n, c) in [(DVec2::Y, y0), (DVec2::NEG_Y, -y1)] {
+                clip(&mut poly, &mut scratch, n, c);
+                if poly.len() < 3 {
+                    break;
+                }
+            }
+            sum += self.covered(&poly);
+        }
+        sum
     }
 
     /// Area of the light inside the axis-aligned rectangle `lo..hi`.
     pub fn clipped_area(&self, lo: DVec2, hi: DVec2) -> f64 {
+        if let Some(area) = self.box_overlap(lo, hi) {
+            return area;
+        }
         let poly = self.clip_rect(lo, hi);
         if poly.len() < 3 {
             0.0
@@ -343,6 +419,38 @@ mod tests {
             l.clipped_area(DVec2::new(1.0, 1.0), DVec2::new(2.0, 2.0)),
             0.0
         );
+    }
+
+    /// A strip of intervals is the sum of its rectangles and of their polygon clips, on a box
+    /// light (the fast path) and on a hexagon (clipped once to the strip, then to each
+    /// interval).
+    #[test]
+    fn strips_are_the_sums_of_their_rectangles() {
+        let hexagon: Vec<Vec2> = (0..6)
+            .map(|k| {
+                let a = k as f32 * std::f32::consts::TAU / 6.0;
+                Vec2::new(0.5 * a.cos(), 0.5 * a.sin())
+            })
+            .collect();
+        let ys = [(-0.6, -0.3), (-0.1, 0.05), (0.2, 0.7)];
+        for l in [square(), LightDomain::new(&hexagon)] {
+            for (x0, x1) in [(-0.7, -0.2), (-0.3, 0.4), (0.45, 0.9)] {
+                let strip = l.strip(x0, x1, &ys).area;
+                let sum: f64 = ys
+                    .iter()
+                    .map(|&(y0, y1)| l.rect(DVec2::new(x0, y0), DVec2::new(x1, y1)).area)
+                    .sum();
+                assert!((strip - sum).abs() < 1e-12, "{strip} against {sum}");
+                let by_clip: f64 = ys
+                    .iter()
+                    .map(|&(y0, y1)| {
+                        polygon_area(&l.clip_rect(DVec2::new(x0, y0), DVec2::new(x1, y1))).abs()
+                    })
+                    .sum();
+                assert!((strip - by_clip).abs() < 1e-12, "{strip} against {by_clip}");
+            }
+        }
+        assert!(square().is_box && !LightDomain::new(&hexagon).is_box);
     }
 
     /// GBP07 section 4.2: the radial integral of one edge is the light clipped to the wedge

@@ -7,7 +7,7 @@
 
 use glam::DVec2;
 
-/// Buffers of [`disjoint_pieces`], reused across receivers.
+/// Buffers of [`disjoint_strips`], reused across receivers.
 #[derive(Debug, Default)]
 pub struct UnionScratch {
     rects: Vec<(DVec2, DVec2)>,
@@ -18,12 +18,13 @@ pub struct UnionScratch {
     open: Vec<(f64, f64)>,
 }
 
-/// Appends to `out` disjoint rectangles `(lo, hi)` whose union is the union of `rects` (empty
-/// or inverted rectangles and non-finite ones are ignored).
-pub fn disjoint_pieces(
+/// Hands `piece` disjoint strips whose union is the union of `rects` (empty or inverted
+/// rectangles and non-finite ones are ignored): each strip is an x range and the disjoint,
+/// increasing y intervals covered across it.
+pub fn disjoint_strips(
     rects: &[(DVec2, DVec2)],
     scratch: &mut UnionScratch,
-    out: &mut Vec<(DVec2, DVec2)>,
+    mut piece: impl FnMut(f64, f64, &[(f64, f64)]),
 ) {
     let s = scratch;
     s.rects.clear();
@@ -48,17 +49,19 @@ pub fn disjoint_pieces(
     for k in 0..s.xs.len() {
         let x0 = s.xs[k];
         // The slab [x0, x1]: every rectangle starting at or before x0 and ending after it
-        // spans it (every edge is in `xs`).
-        while next < s.rects.len() && s.rects[next].0.x <= x0 {
-            s.active.push(next);
+        // spans it (every edge is in `xs`). The active rectangles are kept in order of their lower y, so that the slab's
+        // intervals come sorted.
+        let rects = &s.rects;
+        while next < rects.len() && rects[next].0.x <= x0 {
+            let y = rects[next].0.y;
+            let at = s.active.partition_point(|&i| rects[i].0.y <= y);
+            s.active.insert(at, next);
             next += 1;
         }
-        let rects = &s.rects;
         s.active.retain(|&i| rects[i].1.x > x0);
         s.intervals.clear();
         s.intervals
             .extend(s.active.iter().map(|&i| (rects[i].0.y, rects[i].1.y)));
-        s.intervals.sort_by(|a, b| a.0.total_cmp(&b.0));
         s.merged.clear();
         for &(y0, y1) in &s.intervals {
             match s.merged.last_mut() {
@@ -67,9 +70,9 @@ pub fn disjoint_pieces(
             }
         }
         if s.merged != s.open {
-            // The open pieces end here; the slab's own begin.
-            for &(y0, y1) in &s.open {
-                out.push((DVec2::new(open_x, y0), DVec2::new(x0, y1)));
+            // The open strip ends here; the slab's own begins.
+            if !s.open.is_empty() {
+                piece(open_x, x0, &s.open);
             }
             std::mem::swap(&mut s.open, &mut s.merged);
             open_x = x0;
@@ -88,6 +91,20 @@ mod tests {
             .iter()
             .map(|(lo, hi)| (hi.x - lo.x) * (hi.y - lo.y))
             .sum()
+    }
+
+    /// The strips as rectangles.
+    fn disjoint_pieces(
+        rects: &[(DVec2, DVec2)],
+        scratch: &mut UnionScratch,
+        out: &mut Vec<(DVec2, DVec2)>,
+    ) {
+        disjoint_strips(rects, scratch, |x0, x1, ys| {
+            out.extend(
+                ys.iter()
+                    .map(|&(y0, y1)| (DVec2::new(x0, y0), DVec2::new(x1, y1))),
+            );
+        });
     }
 
     fn r(x0: f64, y0: f64, x1: f64, y1: f64) -> (DVec2, DVec2) {
