@@ -31,17 +31,15 @@ fn exact(samples: u32, seed: u64, name: &str) -> Box<dyn ShadowTechnique> {
 
 /// Numerical ties only: a handful of flipped samples.
 fn tie_budget(samples: u32, scene: &str) -> Option<Budget> {
-    shadow_core::scenes::BUILTIN_SCENES
-        .contains(&scene)
-        .then_some(Budget {
-            rmse: 0.004,
-            penumbra_rmse: 0.006,
-            bias: 0.001,
-            max_abs: (2.0 / samples as f64).max(0.02),
-            share_over_0_1: 0.001,
-            false_shadow: 0.001,
-            min_sample_agreement: Some(0.999),
-        })
+    shadow_core::scenes::is_named_scene(scene).then_some(Budget {
+        rmse: 0.004,
+        penumbra_rmse: 0.006,
+        bias: 0.001,
+        max_abs: (2.0 / samples as f64).max(0.02),
+        share_over_0_1: 0.001,
+        false_shadow: 0.001,
+        min_sample_agreement: Some(0.999),
+    })
 }
 
 /// Every AFSM preset.

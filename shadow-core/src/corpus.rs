@@ -48,6 +48,16 @@ pub fn corpus_scene_names() -> Vec<String> {
         .collect()
 }
 
+/// The small share of the corpus `cargo test` runs: every mesh once, under the lights taken in
+/// turn (mesh k under `CORPUS_LIGHTS[k % 4]`), so each mesh and each light is in it.
+pub fn corpus_share() -> Vec<String> {
+    CORPUS_MESHES
+        .iter()
+        .enumerate()
+        .map(|(k, m)| format!("corpus-{m}-{}", CORPUS_LIGHTS[k % CORPUS_LIGHTS.len()]))
+        .collect()
+}
+
 /// Whether `name` is a corpus scene.
 pub fn is_corpus_scene(name: &str) -> bool {
     split(name).is_some()

@@ -46,12 +46,10 @@ impl Budget {
         }
     }
 
-    /// Looks `scene` up in a table of measured errors (see [`Budget::from_measured`]).
+    /// Looks `scene` up in a table of measured errors (see [`Budget::from_measured`] and
+    /// [`table_row`]).
     pub fn lookup(table: &[(&str, [f64; 5])], scene: &str) -> Option<Self> {
-        table
-            .iter()
-            .find(|(s, _)| *s == scene)
-            .map(|(_, m)| Self::from_measured(*m))
+        table_row(table, scene).map(|m| Self::from_measured(*m))
     }
 
     /// A budget with the same bound on RMSE-like terms and no per-sample requirement.
@@ -66,6 +64,24 @@ impl Budget {
             min_sample_agreement: None,
         }
     }
+}
+
+/// The name of the one row a measured table holds for the whole corpus of real meshes
+/// ([`crate::corpus`]): each measure is its largest over the corpus scenes
+/// (`scripts/measure_budgets.py --corpus` folds them). A budget there is the promise a preset
+/// makes on a real mesh it was never tuned to, the same on all 44 scenes, so one row covers
+/// them; the built-in scenes keep a row each.
+pub const CORPUS_ROW: &str = "corpus";
+
+/// The row of `scene` in a per-scene table: its own row, or for a corpus scene without one the
+/// [`CORPUS_ROW`].
+pub fn table_row<'a, T>(table: &'a [(&str, T)], scene: &str) -> Option<&'a T> {
+    let find = |name: &str| table.iter().find(|(s, _)| *s == name).map(|(_, v)| v);
+    find(scene).or_else(|| {
+        crate::corpus::is_corpus_scene(scene)
+            .then(|| find(CORPUS_ROW))
+            .flatten()
+    })
 }
 
 /// Builds a technique with a given sample count and seed; a count outside the technique's

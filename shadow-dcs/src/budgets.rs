@@ -3,7 +3,9 @@
 //! --techniques dcs-16,dcs-64,dcs-64-interleaved,dcs-256,dcs-standard-silhouettes --quick`
 //! (2026-11-22). The exact presets agree with the reference sample by sample, so only their
 //! semi-opaque error (the saturating opacity sum against the exact transmittance product,
-//! section 3) is measured; elsewhere they get [`crate::presets`]'s tie budget.
+//! section 3) is measured; elsewhere they get [`crate::presets`]'s tie budget, on the built-in
+//! scenes and the corpus of real meshes alike. The `corpus` rows hold the largest error over
+//! the 44 corpus scenes (`cargo xtask conformance --quick --scenes corpus`, folded by `scripts/measure_budgets.py --report ... --corpus`, 2026-12-07; [`shadow_core::preset::CORPUS_ROW`]).
 
 /// `dcs-16`.
 pub const DCS_16_SEMI: &[(&str, [f64; 5])] =
@@ -39,6 +41,7 @@ pub const DCS_64_DISCRETE: &[(&str, [f64; 5])] = &[
     ("spot-lamp", [0.0101, 0.0353, -0.0008, 0.156, 0.0062]),
     ("interior", [0.0058, 0.0199, -0.0000, 0.203, 0.0007]),
     ("interior-window", [0.0109, 0.0204, -0.0001, 0.172, 0.0021]),
+    ("corpus", [0.0045, 0.0161, -0.0003, 0.172, 0.0004]),
 ];
 
 /// `dcs-standard-silhouettes`.
@@ -63,6 +66,7 @@ pub const DCS_STANDARD: &[(&str, [f64; 5])] = &[
     ("spot-lamp", [0.0099, 0.0350, 0.0002, 0.375, 0.0016]),
     ("interior", [0.0085, 0.0276, -0.0001, 0.469, 0.0011]),
     ("interior-window", [0.0196, 0.0370, 0.0025, 0.484, 0.0052]),
+    ("corpus", [0.0900, 0.2191, 0.0129, 0.766, 0.0949]),
 ];
 
 /// `dcs-64-interleaved` (tables with exact borders): semi-opaque only.

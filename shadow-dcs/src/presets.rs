@@ -29,7 +29,7 @@ fn make(samples: u32, strategy: SamplingStrategy, seed: u64) -> Dcs {
 fn exact_budget(samples: u32, semi: &[(&str, [f64; 5])], scene: &str) -> Option<Budget> {
     let mut b = match Budget::lookup(semi, scene) {
         Some(b) => b,
-        None if shadow_core::scenes::BUILTIN_SCENES.contains(&scene) => Budget {
+        None if shadow_core::scenes::is_named_scene(scene) => Budget {
             rmse: 0.004,
             penumbra_rmse: 0.004,
             bias: 0.001,

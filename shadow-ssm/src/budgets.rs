@@ -6,6 +6,12 @@
 //! back-projections united instead of summed), and their measured false-shadow
 //! shares (reference-lit pixels darkened by more than 0.1: shadow-map aliasing at contacts and
 //! silhouettes).
+//!
+//! The `corpus` rows hold the largest error over the 44 scenes of the corpus of real meshes
+//! (`cargo xtask conformance --quick --scenes corpus`, folded by `scripts/measure_budgets.py
+//! --report ... --corpus`, 2026-12-07; [`shadow_core::preset::CORPUS_ROW`]). Their max error
+//! reaches 1: a few pixels on thin parts of a mesh in its own shade (a cow's legs and horns)
+//! are lit where the reference has umbra (not yet diagnosed), while RMSE stays at 0.02 to 0.04.
 
 /// `pcf`.
 pub const PCF: &[(&str, [f64; 5])] = &[
@@ -20,6 +26,7 @@ pub const PCF: &[(&str, [f64; 5])] = &[
     ("grass", [0.0812, 0.2081, -0.0019, 0.680, 0.0986]),
     ("contact", [0.0532, 0.1573, -0.0021, 0.548, 0.0432]),
     ("spot-lamp", [0.0572, 0.2007, -0.0001, 0.540, 0.0589]),
+    ("corpus", [0.1248, 0.3047, 0.0042, 0.895, 0.1297]),
 ];
 
 /// `pcf` false-shadow shares.
@@ -31,6 +38,7 @@ pub const PCF_FALSE_SHADOW: &[(&str, f64)] = &[
     ("spot-self-shadow", 0.0030),
     ("grass", 0.0001),
     ("contact", 0.0008),
+    ("corpus", 0.0097),
 ];
 
 /// `pcss`.
@@ -46,6 +54,7 @@ pub const PCSS: &[(&str, [f64; 5])] = &[
     ("grass", [0.0614, 0.1024, 0.0099, 0.592, 0.0457]),
     ("contact", [0.0365, 0.0842, -0.0010, 0.504, 0.0297]),
     ("spot-lamp", [0.0207, 0.0591, 0.0004, 0.305, 0.0094]),
+    ("corpus", [0.0654, 0.2556, -0.0066, 1.000, 0.0741]),
 ];
 
 /// `pcss` false-shadow shares.
@@ -57,6 +66,7 @@ pub const PCSS_FALSE_SHADOW: &[(&str, f64)] = &[
     ("spot-self-shadow", 0.0003),
     ("grass", 0.0002),
     ("contact", 0.0019),
+    ("corpus", 0.0096),
 ];
 
 /// `ssm-backprojection`.
@@ -73,6 +83,7 @@ pub const BACKPROJECTION: &[(&str, [f64; 5])] = &[
     ("contact", [0.0270, 0.0774, -0.0040, 0.690, 0.0188]),
     ("textured-light", [0.0254, 0.0238, 0.0012, 0.415, 0.0177]),
     ("spot-lamp", [0.0112, 0.0325, -0.0008, 0.199, 0.0044]),
+    ("corpus", [0.0496, 0.1677, -0.0101, 1.000, 0.0504]),
 ];
 
 /// `ssm-backprojection` false-shadow shares.
@@ -85,6 +96,7 @@ pub const BACKPROJECTION_FALSE_SHADOW: &[(&str, f64)] = &[
     ("grass", 0.0001),
     ("contact", 0.0001),
     ("textured-light", 0.0000),
+    ("corpus", 0.0007),
 ];
 
 /// `ssm-peeling`.
@@ -104,6 +116,7 @@ pub const PEELING: &[(&str, [f64; 5])] = &[
     ("contact", [0.0150, 0.0394, -0.0016, 0.658, 0.0050]),
     ("textured-light", [0.0164, 0.0164, -0.0019, 0.249, 0.0080]),
     ("spot-lamp", [0.0080, 0.0177, -0.0003, 0.128, 0.0031]),
+    ("corpus", [0.0288, 0.0924, 0.0021, 1.000, 0.0173]),
 ];
 
 /// `ssm-peeling` false-shadow shares.
@@ -116,6 +129,7 @@ pub const PEELING_FALSE_SHADOW: &[(&str, f64)] = &[
     ("grass", 0.0001),
     ("contact", 0.0001),
     ("textured-light", 0.0000),
+    ("corpus", 0.0003),
 ];
 
 /// `ssm-contours`.
@@ -132,6 +146,7 @@ pub const CONTOURS: &[(&str, [f64; 5])] = &[
     ("contact", [0.0156, 0.0461, -0.0003, 0.504, 0.0050]),
     ("textured-light", [0.0257, 0.0239, 0.0014, 0.407, 0.0180]),
     ("spot-lamp", [0.0076, 0.0156, 0.0002, 0.116, 0.0034]),
+    ("corpus", [0.0427, 0.1591, 0.0098, 1.000, 0.0364]),
 ];
 
 /// `ssm-contours` false-shadow shares.
@@ -144,6 +159,7 @@ pub const CONTOURS_FALSE_SHADOW: &[(&str, f64)] = &[
     ("grass", 0.0000),
     ("contact", 0.0001),
     ("textured-light", 0.0000),
+    ("corpus", 0.0005),
 ];
 
 /// `ssm-adaptive`.
@@ -160,6 +176,7 @@ pub const ADAPTIVE: &[(&str, [f64; 5])] = &[
     ("contact", [0.0159, 0.0467, -0.0002, 0.504, 0.0051]),
     ("textured-light", [0.0267, 0.0249, 0.0021, 0.419, 0.0188]),
     ("spot-lamp", [0.0076, 0.0156, 0.0002, 0.116, 0.0034]),
+    ("corpus", [0.0391, 0.1591, 0.0098, 1.000, 0.0379]),
 ];
 
 /// `ssm-adaptive` false-shadow shares.
@@ -172,4 +189,5 @@ pub const ADAPTIVE_FALSE_SHADOW: &[(&str, f64)] = &[
     ("grass", 0.0000),
     ("contact", 0.0001),
     ("textured-light", 0.0000),
+    ("corpus", 0.0005),
 ];

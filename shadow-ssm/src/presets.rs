@@ -12,7 +12,7 @@ use crate::{Contours, Filter, ScreenSpace, ShadowMapFilter};
 /// and 0.002, as [`Budget::from_measured`] treats the share over 0.1).
 fn budget(table: &[(&str, [f64; 5])], false_shadow: &[(&str, f64)], scene: &str) -> Option<Budget> {
     let mut b = Budget::lookup(table, scene)?;
-    if let Some((_, fs)) = false_shadow.iter().find(|(s, _)| *s == scene) {
+    if let Some(fs) = shadow_core::preset::table_row(false_shadow, scene) {
         b.false_shadow = fs * 1.25 + 0.002;
     }
     Some(b)

@@ -7,6 +7,11 @@
 //! cargo test -p shadow-tests --test conformance -- --list
 //! ```
 //!
+//! After the built-in scenes come scenes of the corpus of real meshes
+//! (`shadow_core::corpus`): a small share by default (`corpus_share`: every mesh once, the
+//! lights in turn), all 44 with `SHADOW_TEST_CORPUS=all` (how the corpus rows of the budget
+//! tables are measured). `cargo xtask conformance --corpus` runs them all with the report.
+//!
 //! A case the preset's capabilities exclude checks that preparing it is refused with a typed
 //! reason; a preset that fails to run is a failure. Without a GPU adapter (and without
 //! `SHADOW_REQUIRE_GPU`) a GPU case says so loudly and passes; with it, a missing adapter is a
@@ -20,21 +25,22 @@ use shadow_conformance::conformance::{
     GPU_TEST_RESOLUTION, Outcome, SceneContext, SuiteConfig, run_case,
 };
 use shadow_conformance::registry;
+use shadow_core::corpus::{corpus_scene_names, corpus_share};
 use shadow_core::preset::Preset;
 use shadow_core::scenes::{BUILTIN_SCENES, builtin};
 use shadow_core::technique::{Processor, UnsupportedReason};
 
 /// A scene's context, built by the first case that needs it and shared by the others.
 struct LazyContext {
-    scene: &'static str,
+    scene: String,
     config: SuiteConfig,
     cell: OnceLock<Result<SceneContext, String>>,
 }
 
 impl LazyContext {
-    fn new(scene: &'static str, config: SuiteConfig) -> Arc<Self> {
+    fn new(scene: &str, config: SuiteConfig) -> Arc<Self> {
         Arc::new(Self {
-            scene,
+            scene: scene.to_string(),
             config,
             cell: OnceLock::new(),
         })
@@ -43,7 +49,7 @@ impl LazyContext {
     fn get(&self) -> Result<&SceneContext, Failed> {
         self.cell
             .get_or_init(|| {
-                builtin(self.scene)
+                builtin(&self.scene)
                     .map_err(|e| e.to_string())
                     .and_then(|s| SceneContext::new(s, self.config))
             })
@@ -177,10 +183,18 @@ fn main() {
     assert!(!presets.is_empty(), "no preset is registered");
     let closed = LazyContext::new("quad-over-plane", closed_cfg);
     let mut trials = Vec::new();
-    for scene in BUILTIN_SCENES {
+    let corpus = match std::env::var("SHADOW_TEST_CORPUS").as_deref() {
+        Ok("all") => corpus_scene_names(),
+        Ok(other) if !other.is_empty() => {
+            panic!("SHADOW_TEST_CORPUS takes `all` (or nothing for the share), not `{other}`")
+        }
+        _ => corpus_share(),
+    };
+    let scenes = BUILTIN_SCENES.iter().map(|s| s.to_string()).chain(corpus);
+    for scene in scenes {
         let (cpu, gpu) = (
-            LazyContext::new(scene, cfg),
-            LazyContext::new(scene, gpu_cfg),
+            LazyContext::new(&scene, cfg),
+            LazyContext::new(&scene, gpu_cfg),
         );
         for &p in &presets {
             let ctx = if on_gpu(&p, cfg.seed) {

@@ -5,7 +5,7 @@
 //! more than two samples' share, the numerical ties).
 
 use shadow_conformance::conformance::{Outcome, SceneContext, SuiteConfig, run_case};
-use shadow_core::corpus::{CORPUS_LIGHTS, CORPUS_MESHES, corpus_scene_names};
+use shadow_core::corpus::{CORPUS_LIGHTS, CORPUS_MESHES, corpus_scene_names, corpus_share};
 use shadow_core::prelude::*;
 use shadow_core::scenes::builtin;
 
@@ -46,8 +46,7 @@ fn every_corpus_scene_loads_in_view_and_in_shadow() {
 #[test]
 fn dcs_equals_the_same_samples_reference_on_a_share_of_the_corpus() {
     let dcs = shadow_conformance::preset("dcs-64").unwrap();
-    for (k, mesh) in CORPUS_MESHES.iter().enumerate() {
-        let name = format!("corpus-{mesh}-{}", CORPUS_LIGHTS[k % CORPUS_LIGHTS.len()]);
+    for name in corpus_share() {
         let ctx = SceneContext::new(builtin(&name).unwrap(), small()).unwrap();
         match run_case(&dcs, &ctx) {
             Outcome::Ran(r) => {

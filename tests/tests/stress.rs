@@ -16,8 +16,15 @@ fn every_preset_holds_the_stress_cases() {
     let mut failed = Vec::new();
     let mut limitations_seen = 0;
     let presets = registry();
+    // Two scenes of the corpus of real meshes, one under each light shape; `cargo xtask
+    // stress` runs more.
+    let corpus = [
+        "corpus-stanford-bunny-disk-whole",
+        "corpus-fandisk-rect-quarter",
+    ]
+    .map(String::from);
     for p in &presets {
-        for r in technique_cases(p, 48, 36) {
+        for r in technique_cases(p, 48, 36, &corpus) {
             if let Some(reason) = known_limitation(p, &r.case) {
                 assert!(
                     !r.held,

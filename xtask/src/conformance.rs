@@ -36,9 +36,13 @@ fn save(img: &image::RgbImage, path: &std::path::Path) -> Result<(), String> {
 
 #[derive(Args)]
 pub struct ConformanceArgs {
-    /// Scenes to run (comma-separated; default: all built-in scenes).
+    /// Scenes to run (comma-separated built-in or corpus names, or `corpus` for every corpus
+    /// scene; default: all built-in scenes).
     #[arg(long, value_delimiter = ',')]
     scenes: Vec<String>,
+    /// Add every scene of the corpus of real meshes (`cargo xtask scenes` lists them).
+    #[arg(long)]
+    corpus: bool,
     /// Presets to run (comma-separated; default: all registered presets).
     #[arg(long, value_delimiter = ',')]
     techniques: Vec<String>,
@@ -62,6 +66,24 @@ pub struct ConformanceArgs {
     quick: bool,
 }
 
+/// The scenes of a run, in order: the built-in ones named (all of them when no scene is
+/// named), then the corpus scenes named or, with `corpus`, all of them.
+fn conformance_scenes(named: &[String], corpus: bool) -> Vec<String> {
+    let wanted = |s: &str| named.iter().any(|x| x == s);
+    let builtin_all = named.is_empty();
+    let mut scenes: Vec<String> = BUILTIN_SCENES
+        .iter()
+        .filter(|s| builtin_all || wanted(s))
+        .map(|s| (*s).to_string())
+        .collect();
+    scenes.extend(
+        shadow_core::corpus::corpus_scene_names()
+            .into_iter()
+            .filter(|s| corpus || wanted(s)),
+    );
+    scenes
+}
+
 /// Reference sample counts of the equal-error speed-up curve.
 const CURVE: [u32; 6] = [1, 4, 16, 64, 256, 1024];
 
@@ -71,18 +93,16 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
         shadow_conformance::preset(t)?;
     }
     for s in &a.scenes {
-        if !BUILTIN_SCENES.contains(&s.as_str()) {
+        if !shadow_core::scenes::is_named_scene(s) && s != "corpus" {
             return Err(format!(
-                "unknown scene `{s}`; valid names: {}",
+                "unknown scene `{s}`; valid names: {}, the corpus scenes `cargo xtask scenes` \
+                 lists, and `corpus` for all of them",
                 BUILTIN_SCENES.join(", ")
             ));
         }
     }
-    let scenes: Vec<&str> = BUILTIN_SCENES
-        .iter()
-        .copied()
-        .filter(|s| a.scenes.is_empty() || a.scenes.iter().any(|x| x == s))
-        .collect();
+    let corpus = a.corpus || a.scenes.iter().any(|s| s == "corpus");
+    let scenes = conformance_scenes(&a.scenes, corpus);
     let chosen: Vec<_> = presets
         .iter()
         .filter(|p| a.techniques.is_empty() || a.techniques.iter().any(|t| t == p.name))
@@ -111,8 +131,10 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
         .max()
         .unwrap_or(9)
         .max(9);
+    // The second fits the longest scene name (corpus names run to 34 characters).
+    let scene_width = scenes.iter().map(String::len).max().unwrap_or(5).max(22);
     println!(
-        "{:<name_width$} {:<22} {:>8} {:>8} {:>7} {:>8} {:>6} {:>7} {:>28} {:>9}  status",
+        "{:<name_width$} {:<scene_width$} {:>8} {:>8} {:>7} {:>8} {:>6} {:>7} {:>28} {:>9}  status",
         "technique",
         "scene",
         "RMSE",
@@ -167,7 +189,7 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
             match outcome {
                 Outcome::Unsupported { reason } => {
                     println!(
-                        "{:<name_width$} {:<22} unsupported: {reason}",
+                        "{:<name_width$} {:<scene_width$} unsupported: {reason}",
                         p.name, scene
                     );
                     writeln!(
@@ -182,7 +204,10 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
                         .push(html_case(p.name, format!("unsupported: {reason}")));
                 }
                 Outcome::Failed { error } => {
-                    println!("{:<name_width$} {:<22} FAILED: {error}", p.name, scene);
+                    println!(
+                        "{:<name_width$} {:<scene_width$} FAILED: {error}",
+                        p.name, scene
+                    );
                     writeln!(
                         md,
                         "| {} | {} | | | | | | | | FAILED: {} |",
@@ -260,7 +285,7 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
                         speedup,
                         status,
                     ];
-                    let widths = [name_width, 22, 8, 8, 7, 8, 6, 7, 28, 9, 0];
+                    let widths = [name_width, scene_width, 8, 8, 7, 8, 6, 7, 28, 9, 0];
                     let line: Vec<String> = cells
                         .iter()
                         .zip(widths)

@@ -19,6 +19,10 @@ pub struct StressArgs {
     /// Only these presets (comma-separated).
     #[arg(long, value_delimiter = ',')]
     techniques: Vec<String>,
+    /// Run the far-away cases on every scene of the corpus of real meshes (default: its share,
+    /// every mesh once).
+    #[arg(long)]
+    corpus: bool,
     /// Where to write stress.json.
     #[arg(long, default_value = "out/stress")]
     out: PathBuf,
@@ -27,9 +31,14 @@ pub struct StressArgs {
 pub fn run(a: StressArgs) -> Result<(), String> {
     let mut results = input_cases();
     let presets = shadow_conformance::registry();
+    let corpus = if a.corpus {
+        shadow_core::corpus::corpus_scene_names()
+    } else {
+        shadow_core::corpus::corpus_share()
+    };
     for p in &presets {
         if a.techniques.is_empty() || a.techniques.iter().any(|t| t == p.name) {
-            results.extend(technique_cases(p, a.width, a.height));
+            results.extend(technique_cases(p, a.width, a.height, &corpus));
         }
     }
     let known = |r: &shadow_conformance::stress::StressResult| {
@@ -39,10 +48,10 @@ pub fn run(a: StressArgs) -> Result<(), String> {
             .and_then(|p| known_limitation(p, &r.case))
             .is_some()
     };
-    println!("{:<26} {:<12} {:<7} detail", "case", "technique", "result");
+    println!("{:<42} {:<12} {:<7} detail", "case", "technique", "result");
     for r in &results {
         println!(
-            "{:<26} {:<12} {:<7} {}",
+            "{:<42} {:<12} {:<7} {}",
             r.case,
             r.technique,
             if r.held {

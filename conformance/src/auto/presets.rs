@@ -4,7 +4,9 @@
 //! Budgets are errors measured by the conformance suite (128 x 96 pixels, seed 1, reference at
 //! 1024 samples with another seed) with the margins of [`Budget::from_measured`];
 //! `scripts/measure_budgets.py` regenerates the tables. The reference's own error at 1024
-//! samples adds to what `auto` achieves against the study's 4096-sample one.
+//! samples adds to what `auto` achieves against the study's 4096-sample one. The `corpus` rows
+//! hold the largest error over the 44 scenes of the corpus of real meshes
+//! (`cargo xtask conformance --quick --scenes corpus`, folded by `scripts/measure_budgets.py --report ... --corpus`, 2026-12-07; [`shadow_core::preset::CORPUS_ROW`]).
 
 use shadow_core::preset::{Budget, Preset};
 use shadow_core::technique::ShadowTechnique;
@@ -43,6 +45,7 @@ const AUTO_01: &[(&str, [f64; 5])] = &[
     ("spot-lamp", [0.0053, 0.0183, 0.0000, 0.055, 0.0000]),
     ("interior", [0.0054, 0.0181, 0.0001, 0.071, 0.0000]),
     ("interior-window", [0.0047, 0.0087, 0.0001, 0.034, 0.0000]),
+    ("corpus", [0.0103, 0.0532, 0.0002, 0.140, 0.0013]),
 ];
 
 const AUTO_003: &[(&str, [f64; 5])] = &[
@@ -64,6 +67,7 @@ const AUTO_003: &[(&str, [f64; 5])] = &[
     ("spot-lamp", [0.0020, 0.0067, 0.0000, 0.023, 0.0000]),
     ("interior", [0.0021, 0.0072, -0.0000, 0.026, 0.0000]),
     ("interior-window", [0.0032, 0.0059, -0.0000, 0.116, 0.0001]),
+    ("corpus", [0.0031, 0.0201, 0.0001, 0.068, 0.0000]),
 ];
 
 /// The chooser's presets.

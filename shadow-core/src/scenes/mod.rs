@@ -55,6 +55,12 @@ pub const BUILTIN_SCENES: [&str; 15] = [
     "interior-window",
 ];
 
+/// Whether `name` is a built-in scene or a scene of the corpus of real meshes
+/// ([`crate::corpus`]): the scenes the presets' budgets speak for.
+pub fn is_named_scene(name: &str) -> bool {
+    BUILTIN_SCENES.contains(&name) || crate::corpus::is_corpus_scene(name)
+}
+
 const BUNNY_OBJ: &[u8] = include_bytes!("../../assets/models/stanford-bunny.obj");
 const SPOT_OBJ: &[u8] = include_bytes!("../../assets/models/spot.obj");
 /// Written by `scripts/make_spot_lamp_gltf.py`.
