@@ -8,7 +8,8 @@
 //! (structure of arrays, as in Wald et al., "Embree: A Kernel Framework for Efficient CPU Ray
 //! Tracing", SIGGRAPH 2014, section 4), so one group test is six subtractions, six products and
 //! the min/max reductions, four children at a time (SSE2 through `glam::Vec4`, scalar
-//! elsewhere). Sixteen children per node, as in the multi-branching BVHs of Wald, Benthin and
+//! elsewhere; the workspace builds for the machine it runs on, `.cargo/config.toml`, so the
+//! same code gets the VEX encodings of AVX where there is one). Sixteen children per node, as in the multi-branching BVHs of Wald, Benthin and
 //! Boulos, "Getting Rid of Packets" (RT 2008), make the tree shallow, so a segment visits few
 //! nodes and a beam few levels (measured against four and eight: see `docs/benchmarks.md`).
 //!
