@@ -116,3 +116,36 @@ impl std::fmt::Debug for Preset {
             .finish_non_exhaustive()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TABLE: &[(&str, [f64; 5])] = &[
+        ("bunny", [0.01, 0.02, 0.0, 0.1, 0.001]),
+        (CORPUS_ROW, [0.03, 0.05, 0.001, 0.5, 0.01]),
+    ];
+
+    #[test]
+    fn a_scene_takes_its_own_row_and_a_corpus_scene_the_corpus_row() {
+        assert_eq!(table_row(TABLE, "bunny"), Some(&TABLE[0].1));
+        assert_eq!(
+            table_row(TABLE, "corpus-teapot-disk-whole"),
+            Some(&TABLE[1].1)
+        );
+        // Neither a built-in scene without a row nor a name that only looks like the corpus's.
+        assert_eq!(table_row(TABLE, "grass"), None);
+        assert_eq!(table_row(TABLE, "corpus-unknown-disk-whole"), None);
+        assert_eq!(table_row(&TABLE[..1], "corpus-teapot-disk-whole"), None);
+        let b = Budget::lookup(TABLE, "corpus-cow-rect-quarter").unwrap();
+        assert_eq!(b, Budget::from_measured(TABLE[1].1));
+    }
+
+    #[test]
+    fn named_scenes_are_the_built_in_ones_and_the_corpus() {
+        assert!(crate::scenes::is_named_scene("bunny"));
+        assert!(crate::scenes::is_named_scene("corpus-fandisk-rect-quarter"));
+        assert!(!crate::scenes::is_named_scene("corpus"));
+        assert!(!crate::scenes::is_named_scene("my-scene.gltf"));
+    }
+}
