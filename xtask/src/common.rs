@@ -145,7 +145,8 @@ pub fn list_scenes() -> Result<(), String> {
     println!(
         "\nThe corpus of real meshes (`shadow_core::corpus`, {} scenes: each mesh at a largest \
          extent of 1 m on a floor, under a tilted rectangle or a disk light of a quarter or the \
-         whole of that extent), by name in render and bench (`--corpus`): \
+         whole of that extent), by name in render, conformance and bench, all of them with \
+         `--corpus` (conformance, bench, stress) or `conformance --scenes corpus`: \
          corpus-<mesh>-<light>\n  meshes: {}\n  lights: {}",
         shadow_core::corpus::corpus_scene_names().len(),
         shadow_core::corpus::CORPUS_MESHES.join(", "),
