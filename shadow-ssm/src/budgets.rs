@@ -12,9 +12,12 @@
 //! --report ... --corpus`, 2026-12-07; [`shadow_core::preset::CORPUS_ROW`]). Their max error
 //! reaches 1 on a few pixels while RMSE stays at 0.02 to 0.04: on `corpus-cow-rect-quarter`
 //! (128 x 96) `ssm-backprojection` and `ssm-peeling` are off by more than 0.5 on three pixels,
-//! the floor where a hoof meets it (reference 0, these 0.95; not the depth bias: a twentieth
-//! of it leaves that pixel at 0.95, the cause is not found yet) and two on the cow's flank
-//! (0.27 and 0.40 against 0.92); `ssm-contours` on six, `pcss` on nine.
+//! the floor under a hoof's rim (reference 0, these 0.95) and two on the cow's flank (0.27 and
+//! 0.40 against 0.92); `ssm-contours` on six, `pcss` on nine. Under the hoof every segment to
+//! the light meets the hoof 3 mm above the floor (found by intersecting them with every
+//! triangle); not the depth bias (a twentieth of it leaves the pixel at 0.95). At that
+//! distance the kernel is presumably a single texel, so the pixel rests on whether one map
+//! texel holds the hoof: a contact finer than the map.
 
 /// `pcf`.
 pub const PCF: &[(&str, [f64; 5])] = &[
