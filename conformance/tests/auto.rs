@@ -119,3 +119,85 @@ fn bad_budgets_are_errors() {
         );
     }
 }
+
+/// The DCS probe evaluates the reference probe's two sample sets, and DCS agrees with the
+/// reference sample by sample on opaque occluders: both probes find the same shadowed and
+/// penumbra shares and the same variance (up to a few numerical ties), the textured light's
+/// radiance-weighted variance included. `auto` looks with DCS on meshes and with the
+/// reference on semi-opaque occluders and on `grass` (a silhouette edge for every edge).
+#[test]
+fn the_dcs_probe_measures_what_the_reference_probe_measures() {
+    use shadow_conformance::auto::{ProbeKind, measure_features, measure_features_by};
+    for scene in [
+        "bunny",
+        "quad-over-plane",
+        "textured-light",
+        "sphere-light",
+        "spot-self-shadow",
+    ] {
+        let setup = builtin(scene).unwrap();
+        let view = view_of(&setup, 64, 48);
+        let by = |k| {
+            measure_features_by(
+                Some(k),
+                setup.scene.clone(),
+                setup.lights[0].clone(),
+                &view,
+                768,
+                3,
+            )
+            .unwrap()
+        };
+        let (d, r) = (by(ProbeKind::Dcs), by(ProbeKind::Reference));
+        assert_eq!((d.probe, r.probe), (ProbeKind::Dcs, ProbeKind::Reference));
+        assert_eq!(d.probe_pixels, r.probe_pixels, "{scene}");
+        let ties = 2.0 / d.probe_pixels as f64;
+        assert!(
+            (d.sampled_share - r.sampled_share).abs() <= ties
+                && (d.penumbra_share - r.penumbra_share).abs() <= ties,
+            "{scene}: DCS {d:?}, reference {r:?}"
+        );
+        assert!(
+            (d.v16 - r.v16).abs() <= 0.02 * r.v16 + 1e-6,
+            "{scene}: v16 {} against {}",
+            d.v16,
+            r.v16
+        );
+        assert!(d.v16 > 0.0 && d.penumbra_share > 0.0, "{scene}");
+        assert_eq!(d.silhouettes, r.silhouettes);
+    }
+    let chosen = |scene: &str| {
+        let setup = builtin(scene).unwrap();
+        let view = view_of(&setup, 32, 24);
+        measure_features(setup.scene.clone(), setup.lights[0].clone(), &view, 768, 3)
+            .unwrap()
+            .probe
+    };
+    assert_eq!(chosen("bunny"), ProbeKind::Dcs);
+    // DCS chosen after a DCS look runs on the look's preparation.
+    let setup = builtin("bunny").unwrap();
+    let view = view_of(&setup, 64, 48);
+    let auto = Auto::new(AutoBudget::Rmse(0.01), 1).unwrap();
+    let prepared = auto
+        .prepare(setup.scene.clone(), setup.lights[0].clone())
+        .unwrap();
+    assert_eq!(prepared.preparation().counter("auto-probe-dcs"), Some(1));
+    let e = prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
+    assert!(e.decision["choice"].as_str().unwrap().starts_with("dcs-"));
+    assert_eq!(e.stats.counter("auto-probe-preparation-reused"), Some(1));
+    assert_eq!(chosen("semi-opaque"), ProbeKind::Reference);
+    assert_eq!(chosen("grass"), ProbeKind::Reference);
+    let setup = builtin("semi-opaque").unwrap();
+    let view = view_of(&setup, 32, 24);
+    assert!(matches!(
+        measure_features_by(
+            Some(ProbeKind::Dcs),
+            setup.scene.clone(),
+            setup.lights[0].clone(),
+            &view,
+            768,
+            3
+        ),
+        Err(TechniqueError::InvalidInput(_))
+    ));
+}

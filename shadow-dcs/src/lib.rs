@@ -86,4 +86,4 @@ pub mod technique;
 pub use presets::presets;
 pub use stages::discrete::{self, CoveredSamples};
 pub use stages::edges::{self, Silhouettes};
-pub use technique::{Dcs, PerSampleOutput, RayChoice};
+pub use technique::{Dcs, PerSampleOutput, PreparedDcs, RayChoice};

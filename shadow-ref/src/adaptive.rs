@@ -149,6 +149,13 @@ impl std::fmt::Debug for PreparedAdaptive {
 }
 
 impl AdaptiveReference {
+    /// The two independent `B`-sample stratified sets of the probe pass (the first and the
+    /// replicate): another technique that evaluates the same samples per pixel (DCS, which
+    /// agrees with the reference sample by sample) measures the same probe.
+    pub fn probe_samplers(&self) -> [&LightSampler; 2] {
+        [&self.first, &self.replicate]
+    }
+
     /// [`ShadowTechnique::prepare`] with the concrete type, for callers that also want
     /// [`PreparedAdaptive::probe_view`] (the `auto` chooser).
     ///
@@ -208,6 +215,9 @@ pub struct ProbeSummary {
     pub sampled: usize,
     /// Pixels whose samples were neither all visible nor all occluded.
     pub penumbra: usize,
+    /// Pixels where some sample of the two sets is occluded or below the horizon (umbra and
+    /// penumbra): unlike `sampled`, a count any technique with the same samples finds.
+    pub shadowed: usize,
     /// Samples in each probe set (`B`).
     pub batch: u32,
     /// Mean over the valid pixels of the variance of one set's mean, `(m0 - m1)^2 / 2`
@@ -514,6 +524,7 @@ impl PreparedAdaptive {
                         if !acc.clear {
                             sum.sampled += 1;
                             sum.penumbra += usize::from(!acc.lit && !acc.dark);
+                            sum.shadowed += usize::from(!acc.lit);
                             sum.mean_variance += acc.replicate_var;
                             sum.allocation_gain += acc.replicate_var.powf(0.4);
                         }
@@ -531,6 +542,7 @@ impl PreparedAdaptive {
             total.pixels += r.pixels;
             total.sampled += r.sampled;
             total.penumbra += r.penumbra;
+            total.shadowed += r.shadowed;
             total.mean_variance += r.mean_variance;
             powers += r.allocation_gain;
         }

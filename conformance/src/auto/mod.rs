@@ -6,11 +6,12 @@
 //! [`Estimate::decision`].
 //!
 //! The look is the adaptive reference's probe pass ([`shadow_ref::adaptive`]) on a copy of
-//! the view at most [`AutoModel::probe_pixels`] pixels large: a beam and two independent
-//! 16-sample stratified sets per pixel. Their disagreement measures the image's sampling
-//! variance, which carries the light's solid angle, the penumbra's extent and the occluders'
-//! detail at once; the shares of pixels that need samples and that lie in penumbra, and the
-//! triangle count, carry the cost. Capabilities (light kind, semi-opacity, textured lights)
+//! the view at most [`AutoModel::probe_pixels`] pixels large: two independent 16-sample
+//! stratified sets per pixel, evaluated by DCS on opaque scenes (its preparation is then the
+//! DCS configurations' own) and by the reference elsewhere ([`probe`]). The sets'
+//! disagreement measures the image's sampling variance, which carries the light's solid
+//! angle, the penumbra's extent and the occluders' detail at once; the shares of pixels in
+//! shadow and in penumbra, and the triangle count, carry the cost. Capabilities (light kind, semi-opacity, textured lights)
 //! and the outputs asked for (per-sample visibility or direct light need light samples)
 //! filter the candidates first.
 //!
@@ -23,8 +24,9 @@
 //!   the fastest. Times are the fitted ones scaled by the probe's measured speed on this
 //!   machine, so the choice may differ between machines (a time budget is a property of the
 //!   machine).
-//! * A chosen configuration is prepared once and kept for later estimates; the reference
-//!   family reuses the probe's BVH.
+//! * A chosen configuration is prepared once and kept for later estimates; the DCS
+//!   configurations share a DCS probe's preparation, the reference family a reference probe's
+//!   BVH (built on first use after a DCS probe, and then shared).
 //!
 //! The survey (Hasenfratz et al. 2003, section 4.1) notes that none of the algorithms it
 //! reviews picks its own quality from a budget; this is that choice, made on measured models
@@ -33,19 +35,23 @@
 
 pub mod model;
 mod presets;
+mod probe;
 
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
 use serde::Serialize;
 use serde_json::json;
 use shadow_core::prelude::*;
-use shadow_core::raster::RasterView;
+use shadow_core::sampling::SamplingStrategy;
+use shadow_dcs::Dcs;
 use shadow_ref::adaptive::{DEFAULT_BATCH, DEFAULT_CAP, PreparedAdaptive};
 use shadow_ref::{AdaptiveReference, Reference};
 
 pub use model::{AutoModel, Candidate, Config, ErrorModel, Features, Observation, Prediction};
 pub use presets::presets;
+pub use probe::ProbeKind;
+use probe::{Probe, probe_features, probe_reference};
 
 /// Under a time budget a pick must fit `TIME_MARGIN` times its predicted time: the cost
 /// models' error on scenes they were not fitted on reaches about this factor for most
@@ -145,7 +151,7 @@ impl ShadowTechnique for Auto {
         light: Light,
     ) -> Result<Box<dyn PreparedShadows>, TechniqueError> {
         let t0 = Instant::now();
-        let probe = probe_technique(self.seed)?.prepare_adaptive(scene.clone(), light.clone())?;
+        let probe = Probe::prepare(scene.clone(), light.clone(), self.seed)?;
         let probe_prepare = t0.elapsed().as_secs_f64();
         // Candidates that can handle this scene and light, built once.
         let mut usable = Vec::new();
@@ -160,11 +166,13 @@ impl ShadowTechnique for Auto {
         }
         let mut stats = Stats::default();
         stats.add_time("auto-probe-prepare", probe_prepare);
+        stats.add("auto-probe-dcs", u64::from(probe.kind() == ProbeKind::Dcs));
         Ok(Box::new(PreparedAuto {
             config: self.clone(),
             scene,
             light,
             probe,
+            reference: OnceLock::new(),
             probe_prepare,
             usable,
             chosen: Mutex::new(Vec::new()),
@@ -173,12 +181,15 @@ impl ShadowTechnique for Auto {
     }
 }
 
-/// `auto` prepared for a scene and light: the probe's BVH and the usable candidates.
+/// `auto` prepared for a scene and light: the probe and the usable candidates.
 pub struct PreparedAuto {
     config: Auto,
     scene: SceneRef,
     light: Light,
-    probe: PreparedAdaptive,
+    probe: Probe,
+    /// The reference family's BVH after a DCS probe, built when a reference configuration is
+    /// first chosen.
+    reference: OnceLock<PreparedAdaptive>,
     probe_prepare: f64,
     usable: Vec<(Candidate, Box<dyn ShadowTechnique>)>,
     /// Configurations already prepared by an earlier estimate, by name: a renderer that calls
@@ -216,8 +227,8 @@ pub struct Decision {
 }
 
 impl PreparedAuto {
-    /// Candidate `i` prepared: from the cache, else prepared now (the reference family on the
-    /// probe's BVH) and cached.
+    /// Candidate `i` prepared: from the cache, else prepared now (DCS on a DCS probe's
+    /// preparation, the reference family on the shared BVH) and cached.
     fn prepared_choice(&self, i: usize) -> Result<Arc<dyn PreparedShadows>, TechniqueError> {
         let (c, technique) = &self.usable[i];
         let name = c.config.name();
@@ -230,16 +241,24 @@ impl PreparedAuto {
             return Ok(p);
         }
         let seed = self.config.seed;
-        let prepared: Arc<dyn PreparedShadows> = match c.config {
-            Config::Ref { samples } => Arc::new(
-                Reference::stratified(samples, seed)?
+        let prepared: Arc<dyn PreparedShadows> = match (&c.config, self.probe.dcs()) {
+            (Config::Ref { samples }, _) => Arc::new(
+                Reference::stratified(*samples, seed)?
                     .named(&name)
-                    .prepare_sharing(self.probe.reference()),
+                    .prepare_sharing(self.bvh()?.reference()),
             ),
-            Config::RefAdaptive { target } => Arc::new(
-                AdaptiveReference::new(target, DEFAULT_BATCH, DEFAULT_CAP, seed)?
+            (Config::RefAdaptive { target }, _) => Arc::new(
+                AdaptiveReference::new(*target, DEFAULT_BATCH, DEFAULT_CAP, seed)?
                     .named(&name)
-                    .prepare_sharing(self.probe.reference())?,
+                    .prepare_sharing(self.bvh()?.reference())?,
+            ),
+            // The configuration the registry builds (`dcs-16`'s `with_samples`), on the probe's
+            // edges, silhouettes and wedges.
+            (Config::Dcs { samples }, Some(probe)) => Arc::new(
+                Dcs::new(*samples, SamplingStrategy::Stratified, seed)
+                    .map_err(|e| TechniqueError::InvalidInput(e.to_string()))?
+                    .named(&name)
+                    .prepare_sharing(probe)?,
             ),
             _ => Arc::from(technique.prepare(self.scene.clone(), self.light.clone())?),
         };
@@ -247,6 +266,20 @@ impl PreparedAuto {
             list.push((name, prepared.clone()));
         }
         Ok(prepared)
+    }
+
+    /// The prepared reference whose BVH the reference family shares: the probe's, else one
+    /// built now (once).
+    fn bvh(&self) -> Result<&PreparedAdaptive, TechniqueError> {
+        if let Some(r) = self.probe.reference() {
+            return Ok(r);
+        }
+        if let Some(r) = self.reference.get() {
+            return Ok(r);
+        }
+        let r = probe_reference(self.config.seed)?
+            .prepare_adaptive(self.scene.clone(), self.light.clone())?;
+        Ok(self.reference.get_or_init(|| r))
     }
 
     /// Picks a usable candidate for `features` under the budget.
@@ -327,14 +360,9 @@ impl PreparedAuto {
     }
 }
 
-/// The adaptive reference whose probe pass `auto` looks with.
-fn probe_technique(seed: u64) -> Result<AdaptiveReference, TechniqueError> {
-    AdaptiveReference::new(0.01, DEFAULT_BATCH, DEFAULT_CAP, seed ^ 0xa070)
-}
-
 /// The features of `scene` lit by `light` seen in `view` (see [`model::Features`]), measured
-/// as `auto` measures them: the probe prepared and run on a copy of the view of at most
-/// `probe_pixels` pixels, both timed.
+/// as `auto` measures them: the probe ([`probe`]) prepared and run on a copy of the view of at
+/// most `probe_pixels` pixels, both timed.
 ///
 /// # Errors
 /// The probe's preparation or rasterization error.
@@ -345,76 +373,36 @@ pub fn measure_features(
     probe_pixels: u32,
     seed: u64,
 ) -> Result<Features, TechniqueError> {
+    measure_features_by(None, scene, light, view, probe_pixels, seed)
+}
+
+/// [`measure_features`] with the probe `kind` (`None`: the one `auto` would choose).
+///
+/// # Errors
+/// As [`measure_features`]; a DCS probe of a scene DCS does not take or of semi-opaque
+/// occluders.
+pub fn measure_features_by(
+    kind: Option<ProbeKind>,
+    scene: SceneRef,
+    light: Light,
+    view: &ViewSamples,
+    probe_pixels: u32,
+    seed: u64,
+) -> Result<Features, TechniqueError> {
     let t0 = Instant::now();
-    let probe = probe_technique(seed)?.prepare_adaptive(scene.clone(), light.clone())?;
+    let probe = match kind {
+        None => Probe::prepare(scene.clone(), light.clone(), seed)?,
+        Some(k) => Probe::prepare_kind(k, scene.clone(), light.clone(), seed)?,
+    };
     let prepare = t0.elapsed().as_secs_f64();
     probe_features(
         &probe,
         scene.as_ref(),
-        light.center(),
+        light.as_ref(),
         prepare,
         view,
         probe_pixels,
     )
-}
-
-/// The probe's features of `view`, `prepare` the seconds its preparation took.
-fn probe_features(
-    probe: &PreparedAdaptive,
-    scene: &dyn Scene,
-    light_centre: glam::Vec3,
-    prepare: f64,
-    view: &ViewSamples,
-    probe_pixels: u32,
-) -> Result<Features, TechniqueError> {
-    let most = u64::from(probe_pixels.max(1));
-    let (w, h) = (u64::from(view.width()), u64::from(view.height()));
-    // The smallest integer reduction that fits the probe's pixel budget.
-    let mut k = 1u64;
-    while (w / k).max(1) * (h / k).max(1) > most {
-        k += 1;
-    }
-    let t0 = Instant::now();
-    let low = RasterView {
-        width: (w / k).max(1) as u32,
-        height: (h / k).max(1) as u32,
-        ..*view.raster_view()
-    };
-    let small = ViewSamples::render_view(scene, &low)?;
-    // A view whose surfaces are too small for the reduced copy is probed at full size.
-    let probed = if small.valid_count() == 0 {
-        probe.probe_view(view)
-    } else {
-        probe.probe_view(&small)
-    };
-    let pixels = probed.pixels.max(1) as f64;
-    Ok(Features {
-        triangles: scene.triangle_count(),
-        silhouettes: silhouettes(scene, light_centre),
-        semi_opaque: scene.has_semi_opaque(),
-        pixels: view.valid_count(),
-        sampled_share: probed.sampled as f64 / pixels,
-        penumbra_share: probed.penumbra as f64 / pixels,
-        v16: probed.mean_variance,
-        probe_pixels: probed.pixels,
-        probe_seconds: prepare + t0.elapsed().as_secs_f64(),
-    })
-}
-
-/// Edges of `scene` that are silhouettes seen from `c`: a boundary or non-manifold edge, or
-/// one whose two faces lie on opposite sides of `c` (one faces it, the other does not).
-fn silhouettes(scene: &dyn Scene, c: glam::Vec3) -> usize {
-    let topo = scene.topology();
-    let faces_c = |f: u32| {
-        let [a, b, d] = scene.triangle(f as usize);
-        (b - a).cross(d - a).dot(c - a) > 0.0
-    };
-    (0..topo.edge_count())
-        .filter(|&e| match topo.faces(e) {
-            [f0, f1] => faces_c(*f0) != faces_c(*f1),
-            _ => true,
-        })
-        .count()
 }
 
 fn no_candidate(outputs: Outputs) -> TechniqueError {
@@ -440,7 +428,7 @@ impl PreparedShadows for PreparedAuto {
         let features = probe_features(
             &self.probe,
             self.scene.as_ref(),
-            self.light.center(),
+            self.light.as_ref(),
             self.probe_prepare,
             view,
             self.config.model.probe_pixels,
@@ -456,6 +444,17 @@ impl PreparedShadows for PreparedAuto {
         stats.add_time("auto-chosen-prepare", prepare_seconds);
         stats.merge(&est.stats);
         stats.add("auto-probe-pixels", features.probe_pixels as u64);
+        // The chosen configuration on the probe's own preparation: DCS's edges, silhouettes
+        // and wedges, or the reference's BVH.
+        let reused = matches!(
+            (&self.usable[i].0.config, self.probe.kind()),
+            (Config::Dcs { .. }, ProbeKind::Dcs)
+                | (
+                    Config::Ref { .. } | Config::RefAdaptive { .. },
+                    ProbeKind::Reference
+                )
+        );
+        stats.add("auto-probe-preparation-reused", u64::from(reused));
         stats.add("auto-candidates", decision.candidates.len() as u64);
         est.stats = stats;
         est.decision = serde_json::to_value(&decision).unwrap_or(serde_json::Value::Null);

@@ -1,9 +1,10 @@
 //! The cost and error models of the `auto` chooser, their fit and their predictions.
 //!
 //! **Features** of a scene and view ([`Features`]) are deterministic for a seed: the triangle
-//! count, the valid pixels, and what the adaptive reference's probe pass (a beam and two
-//! independent 16-sample stratified sets per pixel, on a low-resolution copy of the view)
-//! finds: the share of pixels that need samples, the share in penumbra, and the mean variance
+//! count, the valid pixels, and what the probe pass (two independent 16-sample stratified sets
+//! per pixel, on a low-resolution copy of the view, evaluated by DCS or by the reference on the
+//! same samples, [`super::probe`]) finds: the share of pixels in shadow (some sample occluded),
+//! the share in penumbra, and the mean variance
 //! `v16` of a 16-sample estimate, which is the image MSE of the 16-sample reference. The probe
 //! stands for the light's solid angle and the penumbra's extent at once: both enter the
 //! pixels' variance.
@@ -19,9 +20,12 @@
 //!
 //! **Cost** in seconds on the fitting machine: `theta . [triangles, pixels, sampled pixels,
 //! penumbra pixels, silhouette edges x penumbra pixels, sampled pixels x v16^(2/3)]` with
-//! `theta >= 0`, fitted by non-negative least squares on relative errors (every subset of the
+//! `theta >= 0` ("sampled" pixels are the shadowed ones), fitted by non-negative least squares
+//! on relative errors (every subset of the
 //! terms the configuration's work can depend on, [`Config::cost_mask`], the best feasible one
-//! kept). The probe's own cost is fitted the same way on the first four terms; at run time the ratio of the probe's measured time to its
+//! kept). Each probe's own cost is fitted the same way on the scenes it looked at (the
+//! reference's on the first four terms, DCS's with the silhouette term too); at run time the
+//! ratio of the probe's measured time to its
 //! predicted time scales every prediction to the machine at hand. The ratio is common to all
 //! candidates, so under an error budget the choice does not depend on it: it is deterministic.
 
@@ -29,6 +33,8 @@ use serde::{Deserialize, Serialize};
 use shadow_core::prelude::*;
 use shadow_ref::AdaptiveReference;
 use shadow_ref::adaptive::{DEFAULT_BATCH, DEFAULT_CAP};
+
+use super::probe::ProbeKind;
 
 /// The committed model, written by `cargo xtask budgets --write-model`.
 pub const COMMITTED_MODEL: &str = include_str!("../../auto-model.json");
@@ -166,7 +172,8 @@ pub struct Features {
     pub semi_opaque: bool,
     /// Valid pixels of the view.
     pub pixels: usize,
-    /// Share of the probe's pixels that drew samples.
+    /// Share of the probe's pixels in shadow: some sample of the two sets occluded or below the
+    /// horizon (umbra and penumbra).
     pub sampled_share: f64,
     /// Share of the probe's pixels in penumbra.
     pub penumbra_share: f64,
@@ -176,6 +183,9 @@ pub struct Features {
     pub probe_pixels: usize,
     /// Measured seconds of the probe (its preparation and its pass), on this machine.
     pub probe_seconds: f64,
+    /// Which technique the probe ran.
+    #[serde(default)]
+    pub probe: ProbeKind,
 }
 
 impl Features {
@@ -226,8 +236,11 @@ pub struct AutoModel {
     pub probe_pixels: u32,
     /// The quantile of the measured error ratios each `k` is.
     pub error_quantile: f64,
-    /// The probe's cost, as a candidate's.
+    /// The reference probe's cost, as a candidate's.
     pub probe_cost: [f64; COST_TERMS],
+    /// The DCS probe's cost, as a candidate's.
+    #[serde(default)]
+    pub dcs_probe_cost: [f64; COST_TERMS],
     /// The configurations.
     pub candidates: Vec<Candidate>,
 }
@@ -299,16 +312,21 @@ impl AutoModel {
                 }
             })
             .collect();
-        let probe_rows: Vec<([f64; COST_TERMS], f64)> = probes
-            .iter()
-            .map(|f| (f.probe_terms(), f.probe_seconds))
-            .collect();
+        let probe_rows = |kind: ProbeKind| -> Vec<([f64; COST_TERMS], f64)> {
+            probes
+                .iter()
+                .filter(|f| f.probe == kind)
+                .map(|f| (f.probe_terms(), f.probe_seconds))
+                .collect()
+        };
         Self {
             fitted,
             probe_pixels,
             error_quantile,
-            // The probe is the adaptive reference's first pass: BVH, beams, 32 samples.
-            probe_cost: nnls_relative(&probe_rows, PROBE_COST_MASK),
+            // The adaptive reference's first pass: BVH, beams, 32 samples.
+            probe_cost: nnls_relative(&probe_rows(ProbeKind::Reference), PROBE_COST_MASK),
+            // DCS's preparation (edges, silhouettes, wedges) and two 16-sample passes.
+            dcs_probe_cost: nnls_relative(&probe_rows(ProbeKind::Dcs), DCS_PROBE_COST_MASK),
             candidates,
         }
     }
@@ -316,7 +334,11 @@ impl AutoModel {
     /// How much slower this machine is than the fitting one, from the probe's measured and
     /// modelled times (1 when the model has no probe cost).
     pub fn speed_ratio(&self, f: &Features) -> f64 {
-        let modelled = dot(&self.probe_cost, &f.probe_terms());
+        let cost = match f.probe {
+            ProbeKind::Reference => &self.probe_cost,
+            ProbeKind::Dcs => &self.dcs_probe_cost,
+        };
+        let modelled = dot(cost, &f.probe_terms());
         if modelled > 0.0 && f.probe_seconds > 0.0 {
             f.probe_seconds / modelled
         } else {
@@ -353,8 +375,11 @@ pub fn quantile(mut v: Vec<f64>, q: f64) -> Option<f64> {
     Some(v[i])
 }
 
-/// The cost terms the probe's own time may depend on (see [`Config::cost_mask`]).
+/// The cost terms the reference probe's own time may depend on (see [`Config::cost_mask`]).
 pub const PROBE_COST_MASK: u32 = 0b1111;
+
+/// The cost terms the DCS probe's own time may depend on: DCS's (see [`Config::cost_mask`]).
+pub const DCS_PROBE_COST_MASK: u32 = 0b1_1111;
 
 /// Non-negative least squares on relative errors: `theta >= 0` minimising
 /// `sum ((theta . x - t) / t)^2` over the terms in `allowed` (a bit mask), by trying every

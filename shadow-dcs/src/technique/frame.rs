@@ -379,7 +379,42 @@ impl Dcs {
         };
         Ok(PreparedDcs {
             config: self.clone(),
-            p,
+            p: Arc::new(p),
+            stats,
+        })
+    }
+
+    /// This configuration prepared for the scene and light `other` was prepared for, sharing
+    /// `other`'s edges, silhouettes and wedges when nothing of them depends on what differs:
+    /// the same silhouette detection, exact covered samples on both sides (the tables of
+    /// section 7.3 depend on the samples) and no shadow-ray side (it is built on its own
+    /// configuration's samples). Otherwise it prepares afresh. A chooser that probes with one
+    /// sample count and then runs another pays for the preparation once; the counter
+    /// `preparation-shared` says which happened.
+    ///
+    /// # Errors
+    /// As [`Dcs::prepare_dcs`], when it prepares afresh.
+    pub fn prepare_sharing(&self, other: &PreparedDcs) -> Result<PreparedDcs, TechniqueError> {
+        let o = &other.config;
+        let shareable = self.detection == o.detection
+            && self.covered == CoveredSamples::Exact
+            && o.covered == CoveredSamples::Exact
+            && self.rays.is_none()
+            && o.rays.is_none();
+        if !shareable {
+            let mut fresh = self.prepare_dcs(other.p.scene.clone(), other.p.light.clone())?;
+            fresh.stats.add("preparation-shared", 0);
+            return Ok(fresh);
+        }
+        self.capabilities()
+            .require(&self.name, other.p.scene.as_ref(), other.p.light.as_ref())?;
+        let mut stats = Stats::default();
+        stats.add("preparation-shared", 1);
+        stats.add("edges", other.p.edges.len() as u64);
+        stats.add("silhouette-edges", other.p.silhouettes.len() as u64);
+        Ok(PreparedDcs {
+            config: self.clone(),
+            p: Arc::clone(&other.p),
             stats,
         })
     }
@@ -394,6 +429,30 @@ impl Dcs {
         let mut stats = Stats::default();
         // Rays give no depth complexities: a frame whose counters are read is DCS's alone.
         let (f, plan) = self.frame(p, view, output != PerSampleOutput::Counters, &mut stats)?;
+        self.finish(p, &f, &plan, view, output, stats)
+    }
+
+    /// Whether `other`'s frame (integration constants, counter width, square plan) is this
+    /// configuration's too: it depends on the preparation, the covered-sample test, a forced
+    /// counter width and the shadow-ray side, never on the samples.
+    pub(super) fn same_frame(&self, other: &Dcs) -> bool {
+        self.covered == other.covered
+            && self.forced_bits == other.forced_bits
+            && self.rays.is_none()
+            && other.rays.is_none()
+    }
+
+    /// The per-pixel pass of [`Dcs::run`] (Algorithm 2's steps 3 and 4) on a frame already
+    /// built, by this configuration or one with [`Dcs::same_frame`], and its estimate.
+    pub(super) fn finish(
+        &self,
+        p: &Prepared,
+        f: &Frame<'_>,
+        plan: &Plan<'_>,
+        view: &ViewSamples,
+        output: PerSampleOutput,
+        mut stats: Stats,
+    ) -> Result<Estimate, TechniqueError> {
         let n = self.sampler.count() as usize;
         let words = n.div_ceil(64);
         let w = view.width() as usize;
@@ -407,7 +466,7 @@ impl Dcs {
             counts: Counts,
         }
         let strips = stats.time("depth-complexity", || {
-            self.squares(&plan, |job, buffers| {
+            self.squares(plan, |job, buffers| {
                 let rect = job.rect;
                 let m = rect.len();
                 let rw = rect.width() as usize;
@@ -437,8 +496,8 @@ impl Dcs {
                 let values = textured || output == PerSampleOutput::Counters || p.units != 1;
                 self.run_square(
                     p,
-                    &f,
-                    &plan,
+                    f,
+                    plan,
                     job,
                     values,
                     &mut counts,
@@ -593,5 +652,43 @@ impl Dcs {
         stats.add("shared-sample-sets-built", counts.shared_sets_built);
         vis.validate()?;
         Ok(Estimate::new(vis, stats))
+    }
+}
+
+impl PreparedDcs {
+    /// The visibility and per-sample bits of `view` under this configuration and each of
+    /// `others`, as their own [`PreparedShadows::estimate`] would give them, with one frame
+    /// (integration constants, counter width, square plan) for all where they share it: the
+    /// same preparation ([`Dcs::prepare_sharing`]) and configurations that differ only in their
+    /// samples. Independent replicates of one estimate (a variance probe) cost one frame and
+    /// several per-pixel passes. An estimate that cannot share the frame is made on its own.
+    ///
+    /// # Errors
+    /// As [`PreparedShadows::estimate`].
+    pub fn estimate_replicates(
+        &self,
+        others: &[&PreparedDcs],
+        view: &ViewSamples,
+    ) -> Result<Vec<Estimate>, TechniqueError> {
+        let output = PerSampleOutput::Bits;
+        let mut stats = Stats::default();
+        let (f, plan) = self.config.frame(&self.p, view, true, &mut stats)?;
+        let mut out = vec![
+            self.config
+                .finish(&self.p, &f, &plan, view, output, stats)?,
+        ];
+        for o in others {
+            let mut est = if Arc::ptr_eq(&self.p, &o.p) && self.config.same_frame(&o.config) {
+                let mut stats = Stats::default();
+                stats.add("frame-shared", 1);
+                o.config.finish(&o.p, &f, &plan, view, output, stats)?
+            } else {
+                o.config.run(&o.p, view, output)?
+            };
+            est.darken_behind_light(view, o.p.light.as_ref());
+            out.push(est);
+        }
+        out[0].darken_behind_light(view, self.p.light.as_ref());
+        Ok(out)
     }
 }

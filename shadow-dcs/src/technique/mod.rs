@@ -33,7 +33,7 @@
 //! off their surface, exactly as the reference does ([`shadow_core::offset`]), so that with the
 //! same samples the two agree sample by sample up to numerical ties.
 
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use glam::{DVec3, UVec2, Vec2, Vec3};
 use rayon::prelude::*;
@@ -138,7 +138,9 @@ pub struct Dcs {
 /// DCS prepared for one scene and light: its edges, silhouettes, wedges and tables.
 pub struct PreparedDcs {
     config: Dcs,
-    p: Prepared,
+    /// Shared between configurations that differ only in their samples
+    /// ([`Dcs::prepare_sharing`]).
+    p: Arc<Prepared>,
     stats: Stats,
 }
 
@@ -428,16 +430,24 @@ impl Dcs {
         strategy: SamplingStrategy,
         seed: u64,
     ) -> Result<Self, shadow_core::sampling::SamplingError> {
-        Ok(Self {
-            name: format!("dcs-{samples}"),
-            sampler: LightSampler::new(strategy, samples, seed)?,
+        Ok(Self::with_sampler(LightSampler::new(
+            strategy, samples, seed,
+        )?))
+    }
+
+    /// DCS on the samples of `sampler` (another technique's, so that both evaluate the same
+    /// samples), with the defaults of [`Dcs::new`].
+    pub fn with_sampler(sampler: LightSampler) -> Self {
+        Self {
+            name: format!("dcs-{}", sampler.count()),
+            sampler,
             detection: Silhouettes::Accurate,
             covered: CoveredSamples::Exact,
             output: PerSampleOutput::Bits,
             forced_bits: None,
             share_sets: true,
             rays: None,
-        })
+        }
     }
 
     /// Silhouette detection (section 4.1, Fig. 4).
@@ -642,6 +652,11 @@ impl PreparedShadows for PreparedDcs {
 }
 
 impl PreparedDcs {
+    /// The light samples this configuration evaluates.
+    pub fn sampler(&self) -> &LightSampler {
+        &self.config.sampler
+    }
+
     /// Direct illumination of every view sample by DCS eq. 6: the light samples' contributions
     /// weighted by their binary visibility (saturated opacity sums with semi-opaque occluders).
     ///
