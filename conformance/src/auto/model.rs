@@ -20,7 +20,7 @@
 //!
 //! **Cost** in seconds on the fitting machine: `theta . [triangles, pixels, sampled pixels,
 //! penumbra pixels, silhouette edges x penumbra pixels, sampled pixels x v16^(2/3)]` with
-//! `theta >= 0` ("sampled" pixels are the shadowed ones), fitted by non-negative least squares
+//! `theta >= 0` ("sampled" pixels are those the reference traces, [`Features::sampled_share`]), fitted by non-negative least squares
 //! on relative errors (every subset of the
 //! terms the configuration's work can depend on, [`Config::cost_mask`], the best feasible one
 //! kept). Each probe's own cost is fitted the same way on the scenes it looked at (the
@@ -172,8 +172,9 @@ pub struct Features {
     pub semi_opaque: bool,
     /// Valid pixels of the view.
     pub pixels: usize,
-    /// Share of the probe's pixels in shadow: some sample of the two sets occluded or below the
-    /// horizon (umbra and penumbra).
+    /// Share of the probe's pixels the reference traces: those in shadow (some sample of the
+    /// two sets occluded or below the horizon: umbra and penumbra) under a light whose
+    /// bounding quad gives the reference a beam that proves the others lit, else all of them.
     pub sampled_share: f64,
     /// Share of the probe's pixels in penumbra.
     pub penumbra_share: f64,

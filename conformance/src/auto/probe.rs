@@ -302,12 +302,19 @@ pub(super) fn probe_features(
         probe.look(&small, light)?
     };
     let pixels = look.pixels.max(1) as f64;
+    // The pixels the reference must trace: the shadowed ones where its beam can prove the
+    // rest lit (a light with a bounding quad), else every one.
+    let beam = light.geometry().bounding_quad().is_some();
     Ok(Features {
         triangles: scene.triangle_count(),
         silhouettes: probe.silhouettes,
         semi_opaque: scene.has_semi_opaque(),
         pixels: view.valid_count(),
-        sampled_share: look.shadowed as f64 / pixels,
+        sampled_share: if beam {
+            look.shadowed as f64 / pixels
+        } else {
+            1.0
+        },
         penumbra_share: look.penumbra as f64 / pixels,
         v16: look.mean_variance,
         probe_pixels: look.pixels,
