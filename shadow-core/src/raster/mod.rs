@@ -322,6 +322,10 @@ impl Fragments {
 /// Triangles set up at once by [`rasterize`].
 const RASTER_CHUNK: usize = 1 << 18;
 
+/// Bounding-box width (pixels, less one) from which a triangle's rows are scanned by their
+/// covered runs rather than pixel by pixel.
+const SPAN_MIN_WIDTH: u32 = 4;
+
 /// Rasterizes `triangles` (indices into `positions`) into `layers` depth layers.
 ///
 /// # Errors
@@ -374,8 +378,20 @@ pub fn rasterize(
                     let (t, s) = &setups[n as usize];
                     let ys = s.ymin.max(y_lo);
                     let ye = s.ymax.min(y_hi - 1);
+                    // Wide boxes take each row's covered run (the same pixels as the test
+                    // at every centre, [`setup::ConvexRows::row_span`]); narrow ones test
+                    // every pixel, cheaper than finding the run.
+                    let wide = s.xmax - s.xmin >= SPAN_MIN_WIDTH;
                     for y in ys..=ye {
-                        for x in s.xmin..=s.xmax {
+                        let (x0, x1) = if wide {
+                            match s.row_span(y) {
+                                Some(run) => run,
+                                None => continue,
+                            }
+                        } else {
+                            (s.xmin, s.xmax)
+                        };
+                        for x in x0..=x1 {
                             let Some(d) = s.depth_at_center(x, y) else {
                                 continue;
                             };
