@@ -53,10 +53,12 @@ pub use presets::presets;
 pub use probe::ProbeKind;
 use probe::{Probe, probe_features, probe_reference};
 
-/// Under a time budget a pick must fit `TIME_MARGIN` times its predicted time: the cost
-/// models' error on scenes they were not fitted on reaches about this factor for most
-/// configurations (`cargo xtask budgets`, leave-one-out).
-pub const TIME_MARGIN: f64 = 1.5;
+/// Under a time budget a pick must fit `TIME_MARGIN` times its predicted time: the 0.9
+/// quantile of achieved over predicted time of `auto`'s picks under time budgets on scenes the
+/// models were not fitted on (`cargo xtask budgets`, leave-one-out over 21 scenes,
+/// 2026-12-07: 1.99 at 128x96, 2.24 at 256x192; the median is 0.95), so that nine budgets in
+/// ten are met where the prediction is the only guide.
+pub const TIME_MARGIN: f64 = 2.0;
 
 /// What `auto` must meet.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
