@@ -35,7 +35,7 @@
 
 pub mod model;
 mod presets;
-mod probe;
+pub mod probe;
 
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
