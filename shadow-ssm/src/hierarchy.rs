@@ -4,12 +4,15 @@
 //! GBP07 uses to shrink the kernel of eq. 1 until it converges and to classify a receiver as lit,
 //! umbra or penumbra before any exact work.
 
+use rayon::prelude::*;
+
 use crate::shadow_map::ShadowMap;
 
 /// Min and max depth pyramids.
 #[derive(Debug, Clone)]
 pub struct MinMaxPyramid {
-    /// Per level: side in blocks, min depths, max depths (row-major).
+    /// Per level: side in blocks, min depths, max depths (row-major; the max is empty at level
+    /// 0, whose max is its min).
     levels: Vec<(usize, Vec<f32>, Vec<f32>)>,
 }
 
@@ -17,19 +20,32 @@ impl MinMaxPyramid {
     /// Builds the pyramid of a shadow map.
     pub fn build(sm: &ShadowMap) -> Self {
         let r = sm.view.width as usize;
-        let mut levels = vec![(r, sm.depth.clone(), sm.depth.clone())];
+        // Level 0 is the map itself, min and max alike: one copy, read as both.
+        let mut levels = vec![(r, sm.depth.clone(), Vec::new())];
         while levels.last().is_some_and(|l| l.0 > 1) {
             let (side, lo, hi) = levels.last().expect("non-empty");
+            let hi = if hi.is_empty() { lo } else { hi };
+            let side = *side;
             let next = side.div_ceil(2);
             let mut nlo = vec![f32::INFINITY; next * next];
             let mut nhi = vec![f32::NEG_INFINITY; next * next];
-            for y in 0..*side {
-                for x in 0..*side {
-                    let (i, j) = (y * side + x, (y / 2) * next + x / 2);
-                    nlo[j] = nlo[j].min(lo[i]);
-                    nhi[j] = nhi[j].max(hi[i]);
-                }
-            }
+            // Rows of the next level in parallel, each from its (one or) two rows; a last odd
+            // row or column reads its texel twice, which leaves a min or max as it is.
+            nlo.par_chunks_mut(next)
+                .zip(nhi.par_chunks_mut(next))
+                .enumerate()
+                .for_each(|(y, (rlo, rhi))| {
+                    let rows = [2 * y * side, (2 * y + 1).min(side - 1) * side];
+                    for x in 0..next {
+                        let cols = [2 * x, (2 * x + 1).min(side - 1)];
+                        for r in rows {
+                            for c in cols {
+                                rlo[x] = rlo[x].min(lo[r + c]);
+                                rhi[x] = rhi[x].max(hi[r + c]);
+                            }
+                        }
+                    }
+                });
             levels.push((next, nlo, nhi));
         }
         Self { levels }
@@ -81,6 +97,7 @@ impl MinMaxPyramid {
         let size = (x1 - x0 + 1).max(y1 - y0 + 1) as u64;
         let level = (63 - size.leading_zeros() as usize).min(self.levels.len() - 1);
         let (side, lo, hi) = &self.levels[level];
+        let hi = if hi.is_empty() { lo } else { hi };
         let (mut mn, mut mx) = (f32::INFINITY, f32::NEG_INFINITY);
         for by in (y0 >> level)..=(y1 >> level) {
             for bx in (x0 >> level)..=(x1 >> level) {
