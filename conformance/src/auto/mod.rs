@@ -11,9 +11,9 @@
 //! DCS configurations' own) and by the reference elsewhere ([`probe`]). The sets'
 //! disagreement measures the image's sampling variance, which carries the light's solid
 //! angle, the penumbra's extent and the occluders' detail at once; the shares of pixels in
-//! shadow and in penumbra, and the triangle count, carry the cost. Capabilities (light kind, semi-opacity, textured lights)
-//! and the outputs asked for (per-sample visibility or direct light need light samples)
-//! filter the candidates first.
+//! shadow and in penumbra, and the triangle count, carry the cost. Capabilities (light kind,
+//! semi-opacity, textured lights) and the outputs asked for (per-sample visibility or direct
+//! light need light samples) filter the candidates first.
 //!
 //! * Under an error budget the pick is the candidate of least predicted time whose predicted
 //!   RMSE meets the budget; when none does, the one of least predicted RMSE. The choice
