@@ -139,18 +139,26 @@ pub(crate) fn casters_of(scene: &dyn Scene, closed: &[bool]) -> Vec<Caster> {
         .collect()
 }
 
-/// `casters` in buffers of at most `per` casters each.
+/// `casters` in buffers of at most `per` casters each, with their penumbra volumes under the
+/// light bounded by `light` (`volume.rs`; none for the stencil's edges, which the tile test
+/// does not see).
 pub(crate) fn upload_casters(
     gpu: &GpuContext,
     casters: &[Caster],
+    light: Option<&LightBounds>,
     per: usize,
     label: &str,
 ) -> Result<Vec<CasterBatch>, TechniqueError> {
     casters
         .chunks(per)
         .map(|c| {
+            let volumes = match light {
+                Some(b) => crate::volume::volumes(c, b),
+                None => vec![crate::volume::Volume::EVERYWHERE],
+            };
             Ok(CasterBatch {
                 buffer: gpu.storage(label, c)?,
+                volumes: gpu.storage(label, &volumes)?,
                 len: c.len() as u32,
             })
         })

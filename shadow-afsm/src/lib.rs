@@ -60,6 +60,7 @@ mod presets;
 pub mod sample_grid;
 pub mod technique;
 pub mod temporal;
+pub mod volume;
 
 pub use presets::presets;
 pub use technique::{Afsm, PlaneTest, PreparedAfsm};

@@ -196,6 +196,9 @@ pub fn scan(
 pub struct CasterBatch {
     /// The triangles.
     pub buffer: wgpu::Buffer,
+    /// Their penumbra volumes (`volume.rs`), one per triangle; one unbounded volume for the
+    /// stencil's edges.
+    pub volumes: wgpu::Buffer,
     /// How many.
     pub len: u32,
 }
@@ -240,7 +243,7 @@ const TILE_SLOT: usize = 7;
 const PAIR_SLOT: usize = 8;
 /// The tallies of work skipped, kept over every range: cluster culling's (`tile_pairs.wgsl`)
 /// and the pairs whose view sample was already hidden from every light sample (`occlude.wgsl`).
-const SKIPPED_SLOTS: [(usize, &str); 7] = [
+const SKIPPED_SLOTS: [(usize, &str); 8] = [
     (9, "tiles-culled"),
     (10, "texels-culled-by-depth"),
     (11, "pairs-after-umbra"),
@@ -248,9 +251,10 @@ const SKIPPED_SLOTS: [(usize, &str); 7] = [
     (13, "texels-hidden"),
     (14, "tiles-hidden"),
     (15, "texels-culled-by-region"),
+    (16, "texels-culled-by-volume"),
 ];
-/// Tallies buffer length in u32 words (sixteen 64-bit slots).
-const TALLY_WORDS: usize = 32;
+/// Tallies buffer length in u32 words (seventeen 64-bit slots).
+const TALLY_WORDS: usize = 34;
 
 /// The buffers one batch of view samples shares between its caster ranges.
 struct Occlusion<'a> {
@@ -268,6 +272,8 @@ struct Occlusion<'a> {
     tile_depth: &'a wgpu::Buffer,
     texel_depth: &'a wgpu::Buffer,
     tile_box: &'a wgpu::Buffer,
+    texel_near: &'a wgpu::Buffer,
+    tile_near: &'a wgpu::Buffer,
     slots: &'a wgpu::Buffer,
     texel_hidden: &'a wgpu::Buffer,
     tile_count: &'a wgpu::Buffer,
@@ -436,6 +442,9 @@ impl Occlusion<'_> {
                     self.texel_hidden,
                     self.tile_count,
                     self.tile_hidden,
+                    &batch.volumes,
+                    self.texel_near,
+                    self.tile_near,
                 ],
             );
             gpu.dispatch(&mut enc, &pipes.tile_pairs, &b, tiles.div_ceil(64))?;
@@ -566,6 +575,8 @@ pub fn run_batch(
     let texel_depth = gpu.storage_zeroed("texel depths", texels as u64 * 4)?;
     let tile_depth = gpu.storage_zeroed("tile depths", tiles_per_side * tiles_per_side * 4)?;
     let tile_box = gpu.storage_zeroed("tile boxes", tiles_per_side * tiles_per_side * 24)?;
+    let texel_near = gpu.storage_zeroed("texel nearest depths", texels as u64 * 4)?;
+    let tile_near = gpu.storage_zeroed("tile nearest depths", tiles_per_side.pow(2) * 4)?;
     let texel_hidden = gpu.storage_zeroed("hidden per texel", texels as u64 * 4)?;
     let tile_count = gpu.storage_zeroed("view samples per tile", tiles_per_side.pow(2) * 4)?;
     let tile_hidden = gpu.storage_zeroed("hidden per tile", tiles_per_side.pow(2) * 4)?;
@@ -584,6 +595,8 @@ pub fn run_batch(
                 &tile_depth,
                 &tile_box,
                 &tile_count,
+                &texel_near,
+                &tile_near,
             ],
         );
         gpu.dispatch(&mut enc, &pipes.count, &b, groups)?;
@@ -627,6 +640,8 @@ pub fn run_batch(
         tile_depth: &tile_depth,
         texel_depth: &texel_depth,
         tile_box: &tile_box,
+        texel_near: &texel_near,
+        tile_near: &tile_near,
         slots: &slots,
         texel_hidden: &texel_hidden,
         tile_count: &tile_count,

@@ -347,15 +347,16 @@ impl Afsm {
         let semi_opaque = casters.iter().any(|c| c.optical_depth != OPAQUE);
         let limit = self.binding_limit(&gpu);
         let per = (limit / std::mem::size_of::<Region>() as u64).max(1) as usize;
-        let upload = |all: &[Caster], label: &str| upload_casters(&gpu, all, per, label);
-        let batches = upload(&casters, "casters")?;
+        let upload =
+            |all: &[Caster], light, label: &str| upload_casters(&gpu, all, light, per, label);
+        let batches = upload(&casters, Some(&bounds), "casters")?;
         // The stencil pays only when there are several samples to skip.
         let edges = if self.stencil && !self.hard && self.samples > 1 {
             silhouette_edges(scene.as_ref(), &bounds)
         } else {
             Vec::new()
         };
-        let silhouettes = upload(&edges, "silhouette edges")?;
+        let silhouettes = upload(&edges, None, "silhouette edges")?;
         let sets = self.sets(light.as_ref());
         let positions: Vec<[f32; 4]> = sets
             .iter()
@@ -592,7 +593,13 @@ impl Afsm {
             let open = p.open_batches.get_or_init(|| {
                 let all_open = vec![false; p.closed.len()];
                 let casters = casters_of(p.scene.as_ref(), &all_open);
-                upload_casters(&p.gpu, &casters, p.per_batch, "casters, none closed")
+                upload_casters(
+                    &p.gpu,
+                    &casters,
+                    Some(&p.bounds),
+                    p.per_batch,
+                    "casters, none closed",
+                )
             });
             open.as_ref().map_err(Clone::clone)?
         } else {

@@ -5,7 +5,8 @@
 //! disk light, semi-opaque casters, a furnished room lit through a wall, whose view samples
 //! need one frustum per cube face, and grass, where most view samples are hidden from every
 //! light sample after the first range of casters and their texels drop out of later ranges),
-//! while testing fewer pairs.
+//! while testing fewer pairs. The penumbra-volume test (`volume.rs`) leaves, under the
+//! interior's ceiling panel, fewer empty pairs than pairs that hide something.
 
 use std::sync::Arc;
 
@@ -30,6 +31,7 @@ fn cluster_culling_changes_no_bit_and_tests_fewer_pairs() {
         "large-light-close",
         "grass",
         "interior-window",
+        "interior",
     ] {
         let setup = builtin(name).unwrap();
         let view =
@@ -49,12 +51,14 @@ fn cluster_culling_changes_no_bit_and_tests_fewer_pairs() {
         let count = |e: &Estimate, k: &str| e.stats.counter(k).expect("AFSM counts it");
         println!(
             "{name:<18} pairs tested {} -> {}, tiles culled {}, texels culled by depth {}, \
-             texels hidden {}, agreement {:.7}",
+             texels hidden {}, texels culled by volume {}, empty pairs {}, agreement {:.7}",
             count(&plain, "pairs-tested"),
             count(&culled, "pairs-tested"),
             count(&culled, "tiles-culled"),
             count(&culled, "texels-culled-by-depth"),
             count(&culled, "texels-hidden"),
+            count(&culled, "texels-culled-by-volume"),
+            count(&culled, "pairs-empty"),
             m.sample_agreement.unwrap()
         );
         assert_eq!(m.sample_agreement, Some(1.0), "{name}: {m:?}");
@@ -65,6 +69,15 @@ fn cluster_culling_changes_no_bit_and_tests_fewer_pairs() {
             "{name}"
         );
         fewer_somewhere |= count(&culled, "pairs-tested") * 2 < count(&plain, "pairs-tested");
+        if name.starts_with("interior") || name == "bunny" {
+            assert!(count(&culled, "texels-culled-by-volume") > 0, "{name}");
+        }
+        if name == "interior" {
+            // Measured 0.28 at 128x96 (issue 48 asks for below one half).
+            let empty = count(&culled, "pairs-empty") as f64;
+            let share = empty / count(&culled, "pairs-tested") as f64;
+            assert!(share < 0.5, "{name}: {share:.3} of the tested pairs empty");
+        }
         if name == "grass" {
             assert!(count(&culled, "texels-hidden") > 0, "{name}");
             assert_eq!(count(&plain, "texels-hidden"), 0, "{name}");

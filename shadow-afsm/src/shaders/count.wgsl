@@ -3,7 +3,9 @@
 // of the map (a cluster of view samples) also keeps its farthest view sample's depth, the
 // bound that cluster culling tests casters against (`tile_pairs.wgsl`), and each tile the box
 // of its view samples' ray origins (six keys: the complements of the smallest x, y, z, then the
-// largest), and how many view samples it holds; 0 marks none.
+// largest), and how many view samples it holds; 0 marks none. Each texel and each tile keeps its
+// nearest view sample's depth too (as the complement of its bits; 0 marks none), for the
+// penumbra-volume test.
 
 @group(0) @binding(0) var<uniform> P: Params;
 @group(0) @binding(1) var<storage, read> receivers: array<Receiver>;
@@ -13,6 +15,8 @@
 @group(0) @binding(5) var<storage, read_write> tile_depth: array<atomic<u32>>;
 @group(0) @binding(6) var<storage, read_write> tile_box: array<atomic<u32>>;
 @group(0) @binding(7) var<storage, read_write> tile_count: array<atomic<u32>>;
+@group(0) @binding(8) var<storage, read_write> texel_near: array<atomic<u32>>;
+@group(0) @binding(9) var<storage, read_write> tile_near: array<atomic<u32>>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n: vec3<u32>) {
@@ -31,9 +35,11 @@ fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n:
     // Positive floats order as their bits; the floor keeps a listed sample's bound above 0.
     let z = bitcast<u32>(max(q.z, 1e-30));
     atomicMax(&texel_depth[texel], z);
+    atomicMax(&texel_near[texel], ~z);
     let tile = (ty / u32(TILE)) * tiles_per_side() + tx / u32(TILE);
     atomicMax(&tile_depth[tile], z);
     atomicAdd(&tile_count[tile], 1u);
+    atomicMax(&tile_near[tile], ~z);
     let o = receivers[i].origin;
     for (var k = 0u; k < 3u; k++) {
         atomicMax(&tile_box[6u * tile + k], ~order_key(o[k]));
