@@ -113,6 +113,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "tiles-hidden",
         "texels-culled-by-region",
         "texels-culled-by-volume",
+        "super-tiles-culled",
         "tiles-numbered",
     ] {
         println!("  {k} {}", est.stats.counter(k).unwrap_or(0));

@@ -1,10 +1,12 @@
 //! The compute passes and how one batch of view samples runs through them:
 //!
 //! 1. `count` (section 3.1): project each view sample, atomically take a slot in its texel;
+//!    `occupancy`: the map's tiles that hold a view sample, row by row;
 //! 2. `scan_block` / `scan_add`: the running sum of list lengths gives list offsets;
 //! 3. `scatter`: each view sample's index goes to its list's offset plus its slot;
 //! 4. per batch of caster triangles, `influence` (section 4.1); then, per range of casters,
-//!    `tiles` (the map's 8 x 8 texel tiles each region touches, numbered by a running sum),
+//!    `tiles` (the map's occupied 8 x 8 texel tiles each region touches, numbered by a
+//!    running sum),
 //!    `tile_pairs` (cluster culling of each (caster, tile), then the pairs of the overlapping
 //!    texels' lists, numbered by a running sum) and `occlude` (sections 3.2, 3.3, 4.2, 4.3: a
 //!    few consecutive pairs per invocation);
@@ -32,10 +34,19 @@ pub const COMMON: &str = include_str!("shaders/common.wgsl");
 pub const TALLY: &str = include_str!("shaders/tally.wgsl");
 /// Tiles of influence regions (bindings 1 to 3 and their helpers).
 pub const TILING: &str = include_str!("shaders/tiling.wgsl");
+/// Penumbra volumes and their tests against boxes and frustum pieces.
+pub const VOLUME: &str = include_str!("shaders/volume.wgsl");
+/// The occupied tiles of a caster's box in its kept super-tiles.
+pub const OCCUPIED: &str = include_str!("shaders/occupied.wgsl");
 
 /// Every pass: name, source, and the prefixes it is compiled with, in order.
-pub const MODULES: [(&str, &str, &[&str]); 11] = [
+pub const MODULES: [(&str, &str, &[&str]); 12] = [
     ("count", include_str!("shaders/count.wgsl"), &[COMMON]),
+    (
+        "occupancy",
+        include_str!("shaders/occupancy.wgsl"),
+        &[COMMON],
+    ),
     ("scan_block", include_str!("shaders/scan_block.wgsl"), &[]),
     ("scan_add", include_str!("shaders/scan_add.wgsl"), &[]),
     ("scatter", include_str!("shaders/scatter.wgsl"), &[COMMON]),
@@ -47,22 +58,22 @@ pub const MODULES: [(&str, &str, &[&str]); 11] = [
     (
         "tiles",
         include_str!("shaders/tiles.wgsl"),
-        &[COMMON, TALLY],
+        &[COMMON, TALLY, VOLUME, OCCUPIED],
     ),
     (
         "tile_pairs",
         include_str!("shaders/tile_pairs.wgsl"),
-        &[COMMON, TALLY, TILING],
+        &[COMMON, TALLY, VOLUME, OCCUPIED, TILING],
     ),
     (
         "occlude",
         include_str!("shaders/occlude.wgsl"),
-        &[COMMON, TALLY, TILING],
+        &[COMMON, TALLY, OCCUPIED, TILING],
     ),
     (
         "stencil",
         include_str!("shaders/stencil.wgsl"),
-        &[COMMON, TILING],
+        &[COMMON, OCCUPIED, TILING],
     ),
     ("resolve", include_str!("shaders/resolve.wgsl"), &[COMMON]),
     ("hidden", include_str!("shaders/hidden.wgsl"), &[COMMON]),
@@ -87,6 +98,7 @@ pub fn source(name: &str) -> String {
 #[derive(Debug)]
 pub struct Pipelines {
     count: wgpu::ComputePipeline,
+    occupancy: wgpu::ComputePipeline,
     scan_block: wgpu::ComputePipeline,
     scan_add: wgpu::ComputePipeline,
     scatter: wgpu::ComputePipeline,
@@ -108,6 +120,7 @@ impl Pipelines {
         let p = |n: &str| gpu.pipeline(n, &source(n), "main");
         Ok(Self {
             count: p("count")?,
+            occupancy: p("occupancy")?,
             scan_block: p("scan_block")?,
             scan_add: p("scan_add")?,
             scatter: p("scatter")?,
@@ -243,7 +256,7 @@ const TILE_SLOT: usize = 7;
 const PAIR_SLOT: usize = 8;
 /// The tallies of work skipped, kept over every range: cluster culling's (`tile_pairs.wgsl`)
 /// and the pairs whose view sample was already hidden from every light sample (`occlude.wgsl`).
-const SKIPPED_SLOTS: [(usize, &str); 8] = [
+const SKIPPED_SLOTS: [(usize, &str); 9] = [
     (9, "tiles-culled"),
     (10, "texels-culled-by-depth"),
     (11, "pairs-after-umbra"),
@@ -252,9 +265,10 @@ const SKIPPED_SLOTS: [(usize, &str); 8] = [
     (14, "tiles-hidden"),
     (15, "texels-culled-by-region"),
     (16, "texels-culled-by-volume"),
+    (17, "super-tiles-culled"),
 ];
-/// Tallies buffer length in u32 words (seventeen 64-bit slots).
-const TALLY_WORDS: usize = 34;
+/// Tallies buffer length in u32 words (eighteen 64-bit slots).
+const TALLY_WORDS: usize = 36;
 
 /// The buffers one batch of view samples shares between its caster ranges.
 struct Occlusion<'a> {
@@ -274,6 +288,8 @@ struct Occlusion<'a> {
     tile_box: &'a wgpu::Buffer,
     texel_near: &'a wgpu::Buffer,
     tile_near: &'a wgpu::Buffer,
+    occupancy: &'a wgpu::Buffer,
+    super_bounds: &'a wgpu::Buffer,
     slots: &'a wgpu::Buffer,
     texel_hidden: &'a wgpu::Buffer,
     tile_count: &'a wgpu::Buffer,
@@ -315,7 +331,7 @@ impl Occlusion<'_> {
         let mut base = 0;
         while base < batch.len {
             let count = step.min(batch.len - base);
-            self.range(p, work, base, count, stats)?;
+            self.range(p, work, &batch.volumes, base, count, stats)?;
             if let Work::Occlude(_) = work {
                 self.refresh_hidden(&p, stats)?;
             }
@@ -359,6 +375,7 @@ impl Occlusion<'_> {
         &self,
         params: Params,
         work: Work<'_>,
+        volumes: &wgpu::Buffer,
         base: u32,
         count: u32,
         stats: &mut Stats,
@@ -367,15 +384,29 @@ impl Occlusion<'_> {
         let pipes = self.pipes;
         let mut p = params;
         p.work = [base, count, 0, 0];
+        if let Work::Stencil = work {
+            // The stencil's edges have no penumbra volumes: every super-tile is kept.
+            p.options[3] = 0;
+        }
         let mut keep = Vec::new();
         let tile_counts = gpu.storage_zeroed("tile counts", (count as u64 + 1) * 4)?;
+        let caster_masks = gpu.storage_zeroed("kept super-tiles", count as u64 * 12)?;
         let tiles = timed(gpu, stats, "gpu-tiles", || {
             let uni = gpu.uniform("params", &p);
             let mut enc = gpu.encoder();
             enc.clear_buffer(self.tallies, 4 * 2 * TILE_SLOT as u64, Some(16));
             let b = gpu.bind(
                 &pipes.tiles,
-                &[&uni, self.regions, &tile_counts, self.tallies],
+                &[
+                    &uni,
+                    self.regions,
+                    &tile_counts,
+                    self.tallies,
+                    self.occupancy,
+                    &caster_masks,
+                    volumes,
+                    self.super_bounds,
+                ],
             );
             gpu.dispatch(&mut enc, &pipes.tiles, &b, (count as u64).div_ceil(64))?;
             scan(gpu, pipes, &mut enc, &tile_counts, count + 1, &mut keep)?;
@@ -399,8 +430,8 @@ impl Occlusion<'_> {
                     limit: self.shared.limit,
                 });
             }
-            self.range(params, work, base, half, stats)?;
-            return self.range(params, work, base + half, count - half, stats);
+            self.range(params, work, volumes, base, half, stats)?;
+            return self.range(params, work, volumes, base + half, count - half, stats);
         }
         p.work[2] = tiles as u32;
         let batch = match work {
@@ -411,7 +442,15 @@ impl Occlusion<'_> {
                     let mut enc = gpu.encoder();
                     let b = gpu.bind(
                         &pipes.stencil,
-                        &[&uni, self.regions, &tile_counts, self.offsets, self.flags],
+                        &[
+                            &uni,
+                            self.regions,
+                            &tile_counts,
+                            self.offsets,
+                            self.flags,
+                            self.occupancy,
+                            &caster_masks,
+                        ],
                     );
                     gpu.dispatch(&mut enc, &pipes.stencil, &b, tiles.div_ceil(64))?;
                     gpu.submit(enc)
@@ -445,6 +484,8 @@ impl Occlusion<'_> {
                     &batch.volumes,
                     self.texel_near,
                     self.tile_near,
+                    self.occupancy,
+                    &caster_masks,
                 ],
             );
             gpu.dispatch(&mut enc, &pipes.tile_pairs, &b, tiles.div_ceil(64))?;
@@ -472,8 +513,8 @@ impl Occlusion<'_> {
             let mut enc = gpu.encoder();
             enc.copy_buffer_to_buffer(&saved, 0, self.tallies, 0, TALLY_WORDS as u64 * 4);
             gpu.submit(enc)?;
-            self.range(params, work, base, half, stats)?;
-            return self.range(params, work, base + half, count - half, stats);
+            self.range(params, work, volumes, base, half, stats)?;
+            return self.range(params, work, volumes, base + half, count - half, stats);
         }
         if pairs == 0 {
             return Ok(());
@@ -500,6 +541,8 @@ impl Occlusion<'_> {
                     self.shared.lut,
                     self.flags,
                     self.depths,
+                    self.occupancy,
+                    &caster_masks,
                 ],
             );
             gpu.dispatch(&mut enc, &pipes.occlude, &b, groups)?;
@@ -577,6 +620,13 @@ pub fn run_batch(
     let tile_box = gpu.storage_zeroed("tile boxes", tiles_per_side * tiles_per_side * 24)?;
     let texel_near = gpu.storage_zeroed("texel nearest depths", texels as u64 * 4)?;
     let tile_near = gpu.storage_zeroed("tile nearest depths", tiles_per_side.pow(2) * 4)?;
+    let supers = tiles_per_side.div_ceil(4);
+    let super_bounds = gpu.storage_zeroed("super-tile bounds", supers * supers * 32)?;
+    // Per row of tiles, running counts of occupied tiles and their columns.
+    let occupancy = gpu.storage_zeroed(
+        "occupied tiles",
+        (tiles_per_side * (tiles_per_side + 1) + tiles_per_side.pow(2)) * 4,
+    )?;
     let texel_hidden = gpu.storage_zeroed("hidden per texel", texels as u64 * 4)?;
     let tile_count = gpu.storage_zeroed("view samples per tile", tiles_per_side.pow(2) * 4)?;
     let tile_hidden = gpu.storage_zeroed("hidden per tile", tiles_per_side.pow(2) * 4)?;
@@ -597,9 +647,12 @@ pub fn run_batch(
                 &tile_count,
                 &texel_near,
                 &tile_near,
+                &super_bounds,
             ],
         );
         gpu.dispatch(&mut enc, &pipes.count, &b, groups)?;
+        let b = gpu.bind(&pipes.occupancy, &[&uni, &tile_count, &occupancy]);
+        gpu.dispatch(&mut enc, &pipes.occupancy, &b, tiles_per_side.div_ceil(64))?;
         scan(gpu, pipes, &mut enc, &counts, texels + 1, &mut keep)?;
         gpu.submit(enc)?;
         let mut enc = gpu.encoder();
@@ -642,6 +695,8 @@ pub fn run_batch(
         tile_box: &tile_box,
         texel_near: &texel_near,
         tile_near: &tile_near,
+        occupancy: &occupancy,
+        super_bounds: &super_bounds,
         slots: &slots,
         texel_hidden: &texel_hidden,
         tile_count: &tile_count,

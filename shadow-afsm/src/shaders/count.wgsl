@@ -4,8 +4,8 @@
 // bound that cluster culling tests casters against (`tile_pairs.wgsl`), and each tile the box
 // of its view samples' ray origins (six keys: the complements of the smallest x, y, z, then the
 // largest), and how many view samples it holds; 0 marks none. Each texel and each tile keeps its
-// nearest view sample's depth too (as the complement of its bits; 0 marks none), for the
-// penumbra-volume test.
+// nearest view sample's depth too (as the complement of its bits; 0 marks none), and each
+// super-tile of 4 x 4 tiles its depths and origin box, for the penumbra-volume tests.
 
 @group(0) @binding(0) var<uniform> P: Params;
 @group(0) @binding(1) var<storage, read> receivers: array<Receiver>;
@@ -17,6 +17,9 @@
 @group(0) @binding(7) var<storage, read_write> tile_count: array<atomic<u32>>;
 @group(0) @binding(8) var<storage, read_write> texel_near: array<atomic<u32>>;
 @group(0) @binding(9) var<storage, read_write> tile_near: array<atomic<u32>>;
+// Per super-tile of 4 x 4 tiles (`tiles.wgsl`): farthest depth, complement of the nearest,
+// then the six keys of its origin box.
+@group(0) @binding(10) var<storage, read_write> super_bounds: array<atomic<u32>>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n: vec3<u32>) {
@@ -40,9 +43,15 @@ fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n:
     atomicMax(&tile_depth[tile], z);
     atomicAdd(&tile_count[tile], 1u);
     atomicMax(&tile_near[tile], ~z);
+    let supers = (tiles_per_side() + 3u) / 4u;
+    let st = 8u * ((ty / u32(TILE) / 4u) * supers + tx / u32(TILE) / 4u);
+    atomicMax(&super_bounds[st], z);
+    atomicMax(&super_bounds[st + 1u], ~z);
     let o = receivers[i].origin;
     for (var k = 0u; k < 3u; k++) {
         atomicMax(&tile_box[6u * tile + k], ~order_key(o[k]));
         atomicMax(&tile_box[6u * tile + 3u + k], order_key(o[k]));
+        atomicMax(&super_bounds[st + 2u + k], ~order_key(o[k]));
+        atomicMax(&super_bounds[st + 5u + k], order_key(o[k]));
     }
 }

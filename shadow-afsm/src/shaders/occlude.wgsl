@@ -37,6 +37,10 @@
 @group(0) @binding(11) var<storage, read> lut: array<u32>;
 @group(0) @binding(12) var<storage, read> flags: array<u32>;
 @group(0) @binding(13) var<storage, read_write> depths: array<atomic<u32>>;
+// The map's occupied tiles (`occupancy.wgsl`), for `tile_of`.
+@group(0) @binding(14) var<storage, read> occupancy: array<u32>;
+// The super-tiles kept per caster of the range (`tiles.wgsl`), for `tile_of`.
+@group(0) @binding(15) var<storage, read> caster_masks: array<u32>;
 
 // The pair outcomes of the workgroup.
 var<workgroup> outcomes: array<atomic<u32>, 6>;

@@ -6,6 +6,10 @@
 
 @group(0) @binding(0) var<uniform> P: Params;
 @group(0) @binding(4) var<storage, read_write> flags: array<u32>;
+// The map's occupied tiles (`occupancy.wgsl`), for `tile_of`.
+@group(0) @binding(5) var<storage, read> occupancy: array<u32>;
+// The super-tiles kept per caster of the range (`tiles.wgsl`), for `tile_of`.
+@group(0) @binding(6) var<storage, read> caster_masks: array<u32>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n: vec3<u32>) {

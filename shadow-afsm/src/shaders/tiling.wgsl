@@ -36,11 +36,24 @@ fn tile_of(u: u32) -> Tile {
     }
     let t = P.work.x + lo;
     let bbox = regions[t].bbox;
-    let across = tiles_across(bbox).x;
-    let j = u - tile_offsets[lo];
-    let cell = bbox.xy / TILE + vec2<i32>(i32(j % across), i32(j / across));
-    let index = u32(cell.y) * tiles_per_side() + u32(cell.x);
-    return Tile(t, index, TILE * cell, bbox.xy, bbox.zw);
+    // The j-th occupied tile of the box in its kept super-tiles, row by row (`occupied.wgsl`;
+    // every module that tiles declares `occupancy` and `caster_masks`, written by `tiles`).
+    var sp = span_of(bbox);
+    let m = vec3<u32>(caster_masks[3u * lo], caster_masks[3u * lo + 1u], caster_masks[3u * lo + 2u]);
+    sp.mask = m.xy;
+    sp.all = m.z == 1u;
+    var j = u - tile_offsets[lo];
+    var y = sp.y0;
+    for (var r = 0u; r < tiles_per_side(); r++) {
+        let c = span_row_count(sp, y);
+        if j < c {
+            break;
+        }
+        j -= c;
+        y++;
+    }
+    let x = span_row_tile(sp, y, j);
+    return Tile(t, y * tiles_per_side() + x, TILE * vec2<i32>(i32(x), i32(y)), bbox.xy, bbox.zw);
 }
 
 // Conservative rasterisation (section 3.2): texel (tx, ty) overlaps the hull of caster t.
