@@ -12,9 +12,10 @@
 //!   casters only for closed meshes (no bias, section 3.3) and light-sample bitmasks combined by
 //!   AND over planes and atomic OR over triangles (section 4.2); computations restricted to
 //!   non-empty lists, to the planes that cut the light and by conservative back-face culling
-//!   (section 4.3). Before any pair, cluster culling tests each caster against each map tile's
-//!   view samples (their depth, the box of their ray origins and the influence region at their
-//!   depth, after Sintorn et al. 2014's view-sample clusters), and texels, tiles and view
+//!   (section 4.3). Before any pair, cluster culling tests each caster against a hierarchy of
+//!   view-sample clusters (after Sintorn et al. 2014): super-tiles of 4 x 4 map tiles, tiles and
+//!   texels, by their depths, the boxes of their ray origins and the caster's penumbra volume
+//!   ([`volume`]); only tiles that hold view samples are numbered; and texels, tiles and view
 //!   samples already hidden from every light sample drop out of later casters' work.
 //! * [`lut`]: the plane lookup table of section 4.2; [`sample_grid`]: light samples bucketed
 //!   on a planar light so the exact test visits only those a triangle's projection covers.
