@@ -413,6 +413,9 @@ impl Occlusion<'_> {
             gpu.submit(enc)?;
             self.tally(TILE_SLOT)
         })?;
+        if let Work::Occlude(_) = work {
+            stats.add("tiles-numbered", tiles);
+        }
         if tiles == 0 {
             return Ok(());
         }
