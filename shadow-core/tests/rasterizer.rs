@@ -5,7 +5,7 @@
 use glam::{Affine3A, DVec3, Vec3};
 use shadow_core::prelude::*;
 use shadow_core::procedural::{cuboid, quad, uv_sphere};
-use shadow_core::raster::{NO_TRIANGLE, Projection, RasterView, rasterize};
+use shadow_core::raster::{NO_TRIANGLE, Projection, RasterView, rasterize, rasterize_depth};
 
 /// Moller-Trumbore in f64: distance and barycentrics (u, v).
 fn hit(o: DVec3, d: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Option<(f64, f64, f64)> {
@@ -230,6 +230,9 @@ fn depth_peeling_layers_are_strictly_ordered_sorted_hits() {
     .unwrap();
     let view = cam.raster_view(40, 40);
     let frags = rasterize(scene.positions(), scene.triangles(), &view, 3).unwrap();
+    // The depth-only rasterizer keeps the same layers.
+    let depths = rasterize_depth(scene.positions(), scene.triangles(), &view, 3).unwrap();
+    assert_eq!(depths, frags.depth);
     let mut multi = 0;
     for y in 0..40 {
         for x in 0..40 {

@@ -6,7 +6,7 @@
 //! occluder able to shadow them is inside ([`crate::light_view`]).
 
 use glam::{Vec2, Vec3};
-use shadow_core::raster::{RasterError, RasterView, rasterize};
+use shadow_core::raster::{RasterError, RasterView, rasterize_depth};
 use shadow_core::scene::Scene;
 
 use crate::light_frame::LightFrame;
@@ -26,7 +26,8 @@ pub struct ShadowMap {
     /// Depth-peeled layers (BCS06 section 4.1): `layers` depths per texel, nearest first,
     /// strictly increasing, infinite where the beam hits fewer surfaces; `depth` is layer 0.
     pub layers: u32,
-    /// The layered depths, `layers` per texel.
+    /// The layered depths, `layers` per texel; empty for one layer (the map is `depth`, held
+    /// once).
     pub layered: Vec<f32>,
     /// The frustum's window at unit depth.
     pub window: Window,
@@ -80,15 +81,20 @@ impl ShadowMap {
         let resolution = view.width;
         let (left, right, bottom, top, _, _) = view.extents();
         let layers = layers.max(1);
-        let frags = rasterize(scene.positions(), scene.triangles(), &view, layers)?;
-        let first: Vec<f32> = (0..(resolution as usize * view.height as usize))
-            .map(|i| frags.depth[i * layers as usize])
-            .collect();
+        let layered = rasterize_depth(scene.positions(), scene.triangles(), &view, layers)?;
+        let (first, layered) = if layers == 1 {
+            (layered, Vec::new())
+        } else {
+            let first = (0..(resolution as usize * view.height as usize))
+                .map(|i| layered[i * layers as usize])
+                .collect();
+            (first, layered)
+        };
         let min_depth = first.iter().copied().fold(f32::INFINITY, f32::min);
         Ok(Self {
             depth: first,
             layers,
-            layered: frags.depth,
+            layered,
             texels_per_unit: resolution as f64 / (right as f64 - left as f64),
             min_depth,
             window: Window {
@@ -119,6 +125,8 @@ impl ShadowMap {
         let r = self.view.width as i64;
         if x < 0 || y < 0 || x >= r || y >= r || k >= self.layers {
             f32::INFINITY
+        } else if self.layers == 1 {
+            self.depth[(y * r + x) as usize]
         } else {
             self.layered[(y * r + x) as usize * self.layers as usize + k as usize]
         }
@@ -191,11 +199,11 @@ impl ShadowMap {
                     near: 0.1,
                 },
             },
-            depth: depth.clone(),
+            depth,
             texels_per_unit: r as f64 / 2.0,
             min_depth,
             layers: 1,
-            layered: depth,
+            layered: Vec::new(),
             window: Window {
                 mid: Vec2::ZERO,
                 half: 1.0,

@@ -339,13 +339,74 @@ pub fn rasterize(
 ) -> Result<Fragments, RasterError> {
     view.validate(layers)?;
     let (w, h) = (view.width, view.height);
-    let bands = h.div_ceil(BAND) as usize;
     let k = layers as usize;
     let band_len = (BAND * w) as usize * k;
     let mut tri_out = vec![NO_TRIANGLE; (w * h) as usize * k];
     let mut depth_out = vec![f32::INFINITY; (w * h) as usize * k];
-    // Triangles go through in chunks, in order (an equal depth keeps the earlier triangle), so
-    // the set-up data held at once stays bounded: set up whole, 8 million triangles took 3 GB.
+    scan_chunks(positions, triangles, view, |setups, bins| {
+        tri_out
+            .par_chunks_mut(band_len)
+            .zip(depth_out.par_chunks_mut(band_len))
+            .enumerate()
+            .for_each(|(band, (tri_band, depth_band))| {
+                scan_band(setups, &bins[band], band as u32, view, |base, t, d| {
+                    insert_layer(
+                        &mut tri_band[base * k..(base + 1) * k],
+                        &mut depth_band[base * k..(base + 1) * k],
+                        t,
+                        d,
+                    );
+                });
+            });
+    });
+    Ok(Fragments {
+        width: w,
+        height: h,
+        layers,
+        triangle: tri_out,
+        depth: depth_out,
+    })
+}
+
+/// The depths alone of [`rasterize`] (`layers` per pixel, nearest first, infinite where
+/// unused), for shadow maps: the same depths, without the triangle ids' memory and writes.
+///
+/// # Errors
+/// As [`rasterize`].
+pub fn rasterize_depth(
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    view: &RasterView,
+    layers: u32,
+) -> Result<Vec<f32>, RasterError> {
+    view.validate(layers)?;
+    let (w, h) = (view.width, view.height);
+    let k = layers as usize;
+    let band_len = (BAND * w) as usize * k;
+    let mut depth_out = vec![f32::INFINITY; (w * h) as usize * k];
+    scan_chunks(positions, triangles, view, |setups, bins| {
+        depth_out
+            .par_chunks_mut(band_len)
+            .enumerate()
+            .for_each(|(band, depth_band)| {
+                scan_band(setups, &bins[band], band as u32, view, |base, _, d| {
+                    insert_depth(&mut depth_band[base * k..(base + 1) * k], d);
+                });
+            });
+    });
+    Ok(depth_out)
+}
+
+/// Sets up `triangles` in chunks, in order (an equal depth keeps the earlier triangle), so
+/// that the set-up data held at once stays bounded (set up whole, 8 million triangles took
+/// 3 GB), bins each chunk's pieces by band of rows and hands them to `scan`.
+fn scan_chunks(
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    view: &RasterView,
+    mut scan: impl FnMut(&[(u32, ScreenTriangle)], &[Vec<u32>]),
+) {
+    let bands = view.height.div_ceil(BAND) as usize;
     for (c, chunk) in triangles.chunks(RASTER_CHUNK).enumerate() {
         let first = (c * RASTER_CHUNK) as u32;
         // Set-up in parallel; only the pieces that reach a pixel are kept.
@@ -367,53 +428,47 @@ pub fn rasterize(
                 bin.push(n as u32);
             }
         }
-        tri_out
-            .par_chunks_mut(band_len)
-            .zip(depth_out.par_chunks_mut(band_len))
-            .enumerate()
-            .for_each(|(band, (tri_band, depth_band))| {
-                let y_lo = band as u32 * BAND;
-                let y_hi = (y_lo + BAND).min(h);
-                for &n in &bins[band] {
-                    let (t, s) = &setups[n as usize];
-                    let ys = s.ymin.max(y_lo);
-                    let ye = s.ymax.min(y_hi - 1);
-                    // Wide boxes take each row's covered run (the same pixels as the test
-                    // at every centre, [`setup::ConvexRows::row_span`]); narrow ones test
-                    // every pixel, cheaper than finding the run.
-                    let wide = s.xmax - s.xmin >= SPAN_MIN_WIDTH;
-                    for y in ys..=ye {
-                        let (x0, x1) = if wide {
-                            match s.row_span(y) {
-                                Some(run) => run,
-                                None => continue,
-                            }
-                        } else {
-                            (s.xmin, s.xmax)
-                        };
-                        for x in x0..=x1 {
-                            let Some(d) = s.depth_at_center(x, y) else {
-                                continue;
-                            };
-                            let base = (((y - y_lo) * w + x) as usize) * k;
-                            insert_layer(
-                                &mut tri_band[base..base + k],
-                                &mut depth_band[base..base + k],
-                                *t,
-                                d,
-                            );
-                        }
-                    }
-                }
-            });
+        scan(&setups, &bins);
     }
-    Ok(Fragments {
-        width: w,
-        height: h,
-        layers,
-        triangle: tri_out,
-        depth: depth_out,
-    })
+}
+
+/// Scan-converts the pieces `bin` of `setups` within band `band` of rows, in order, handing
+/// each covered pixel's index within the band, triangle and depth to `put`.
+fn scan_band(
+    setups: &[(u32, ScreenTriangle)],
+    bin: &[u32],
+    band: u32,
+    view: &RasterView,
+    mut put: impl FnMut(usize, u32, f32),
+) {
+    let w = view.width;
+    let y_lo = band * BAND;
+    let y_hi = (y_lo + BAND).min(view.height);
+    for &n in bin {
+        let (t, s) = &setups[n as usize];
+        let ys = s.ymin.max(y_lo);
+        let ye = s.ymax.min(y_hi - 1);
+        // Wide boxes take each row's covered run (the same pixels as the test at every
+        // centre, [`setup::ConvexRows::row_span`]); narrow ones test every pixel, cheaper
+        // than finding the run.
+        let wide = s.xmax - s.xmin >= SPAN_MIN_WIDTH;
+        for y in ys..=ye {
+            let (x0, x1) = if wide {
+                match s.row_span(y) {
+                    Some(run) => run,
+                    None => continue,
+                }
+            } else {
+                (s.xmin, s.xmax)
+            };
+            for x in x0..=x1 {
+                let Some(d) = s.depth_at_center(x, y) else {
+                    continue;
+                };
+                put(((y - y_lo) * w + x) as usize, *t, d);
+            }
+        }
+    }
 }
 
 /// Inserts a fragment into a pixel's sorted layer list, keeping depths strictly increasing
@@ -429,6 +484,17 @@ fn insert_layer(tris: &mut [u32], depths: &mut [f32], t: u32, d: f32) {
         depths[i] = depths[i - 1];
     }
     tris[pos] = t;
+    depths[pos] = d;
+}
+
+/// [`insert_layer`] for depths alone: the same positions, since they depend on depths only.
+fn insert_depth(depths: &mut [f32], d: f32) {
+    let k = depths.len();
+    let pos = depths.partition_point(|&x| x < d);
+    if pos == k || depths[pos] == d {
+        return;
+    }
+    depths.copy_within(pos..k - 1, pos + 1);
     depths[pos] = d;
 }
 
