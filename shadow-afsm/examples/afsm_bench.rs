@@ -114,6 +114,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "texels-culled-by-region",
         "texels-culled-by-volume",
         "super-tiles-culled",
+        "casters-culled",
         "tiles-numbered",
     ] {
         println!("  {k} {}", est.stats.counter(k).unwrap_or(0));

@@ -27,6 +27,7 @@ use shadow_core::gpu::{Encoder, GpuContext, GpuError};
 use shadow_core::technique::Stats;
 
 use crate::params::{Params, Receiver, Region};
+use glam::Vec3;
 
 /// The shared WGSL prefix (structures, projection, light support function, tiles).
 pub const COMMON: &str = include_str!("shaders/common.wgsl");
@@ -53,7 +54,7 @@ pub const MODULES: [(&str, &str, &[&str]); 12] = [
     (
         "influence",
         include_str!("shaders/influence.wgsl"),
-        &[COMMON],
+        &[COMMON, TALLY, VOLUME],
     ),
     (
         "tiles",
@@ -256,7 +257,7 @@ const TILE_SLOT: usize = 7;
 const PAIR_SLOT: usize = 8;
 /// The tallies of work skipped, kept over every range: cluster culling's (`tile_pairs.wgsl`)
 /// and the pairs whose view sample was already hidden from every light sample (`occlude.wgsl`).
-const SKIPPED_SLOTS: [(usize, &str); 9] = [
+const SKIPPED_SLOTS: [(usize, &str); 10] = [
     (9, "tiles-culled"),
     (10, "texels-culled-by-depth"),
     (11, "pairs-after-umbra"),
@@ -266,9 +267,10 @@ const SKIPPED_SLOTS: [(usize, &str); 9] = [
     (15, "texels-culled-by-region"),
     (16, "texels-culled-by-volume"),
     (17, "super-tiles-culled"),
+    (18, "casters-culled"),
 ];
-/// Tallies buffer length in u32 words (eighteen 64-bit slots).
-const TALLY_WORDS: usize = 36;
+/// Tallies buffer length in u32 words (nineteen 64-bit slots).
+const TALLY_WORDS: usize = 38;
 
 /// The buffers one batch of view samples shares between its caster ranges.
 struct Occlusion<'a> {
@@ -290,6 +292,7 @@ struct Occlusion<'a> {
     tile_near: &'a wgpu::Buffer,
     occupancy: &'a wgpu::Buffer,
     super_bounds: &'a wgpu::Buffer,
+    batch_box: &'a wgpu::Buffer,
     slots: &'a wgpu::Buffer,
     texel_hidden: &'a wgpu::Buffer,
     tile_count: &'a wgpu::Buffer,
@@ -314,10 +317,24 @@ impl Occlusion<'_> {
         let (gpu, pipes) = (self.gpu, self.pipes);
         let mut p = params;
         p.kind[0] = batch.len;
+        if let Work::Stencil = work {
+            // The stencil's edges have no penumbra volumes.
+            p.options[3] = 0;
+        }
         timed(gpu, stats, "gpu-influence", || {
             let uni = gpu.uniform("params", &p);
             let mut enc = gpu.encoder();
-            let b = gpu.bind(&pipes.influence, &[&uni, &batch.buffer, self.regions]);
+            let b = gpu.bind(
+                &pipes.influence,
+                &[
+                    &uni,
+                    &batch.buffer,
+                    self.regions,
+                    &batch.volumes,
+                    self.batch_box,
+                    self.tallies,
+                ],
+            );
             let groups = (batch.len as u64).div_ceil(64);
             gpu.dispatch(&mut enc, &pipes.influence, &b, groups)?;
             gpu.submit(enc)
@@ -384,10 +401,6 @@ impl Occlusion<'_> {
         let pipes = self.pipes;
         let mut p = params;
         p.work = [base, count, 0, 0];
-        if let Work::Stencil = work {
-            // The stencil's edges have no penumbra volumes: every super-tile is kept.
-            p.options[3] = 0;
-        }
         let mut keep = Vec::new();
         let tile_counts = gpu.storage_zeroed("tile counts", (count as u64 + 1) * 4)?;
         let caster_masks = gpu.storage_zeroed("kept super-tiles", count as u64 * 12)?;
@@ -623,6 +636,15 @@ pub fn run_batch(
     let tile_box = gpu.storage_zeroed("tile boxes", tiles_per_side * tiles_per_side * 24)?;
     let texel_near = gpu.storage_zeroed("texel nearest depths", texels as u64 * 4)?;
     let tile_near = gpu.storage_zeroed("tile nearest depths", tiles_per_side.pow(2) * 4)?;
+    // The box of the batch's ray origins, for the influence pass's root cull.
+    let (lo, hi) = receivers.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), r| (lo.min(r.origin()), hi.max(r.origin())),
+    );
+    let batch_box = gpu.storage(
+        "batch box",
+        &[[lo.x, lo.y, lo.z, 0.0], [hi.x, hi.y, hi.z, 0.0]],
+    )?;
     let supers = tiles_per_side.div_ceil(4);
     let super_bounds = gpu.storage_zeroed("super-tile bounds", supers * supers * 32)?;
     // Per row of tiles, running counts of occupied tiles and their columns.
@@ -700,6 +722,7 @@ pub fn run_batch(
         tile_near: &tile_near,
         occupancy: &occupancy,
         super_bounds: &super_bounds,
+        batch_box: &batch_box,
         slots: &slots,
         texel_hidden: &texel_hidden,
         tile_count: &tile_count,

@@ -5,8 +5,8 @@
 //! disk light, semi-opaque casters, a furnished room lit through a wall, whose view samples
 //! need one frustum per cube face, and grass, where most view samples are hidden from every
 //! light sample after the first range of casters and their texels drop out of later ranges),
-//! while testing fewer pairs. The penumbra-volume tests (`volume.rs`), of super-tiles, tiles
-//! and texels, leave, under the interior's ceiling panel, fewer empty pairs than pairs that
+//! while testing fewer pairs. The penumbra-volume tests (`volume.rs`), of a batch's view
+//! samples, super-tiles, tiles and texels, leave, under the interior's ceiling panel, fewer empty pairs than pairs that
 //! hide something.
 
 use std::sync::Arc;
@@ -74,10 +74,13 @@ fn cluster_culling_changes_no_bit_and_tests_fewer_pairs() {
             assert!(count(&culled, "texels-culled-by-volume") > 0, "{name}");
         }
         if name.starts_with("interior") {
-            // Whole super-tiles of the rooms' walls lie outside most casters' volumes.
+            // Whole super-tiles of the rooms' walls lie outside most casters' volumes, and
+            // each cube face's view samples outside most of the room's.
             assert!(count(&culled, "super-tiles-culled") > 0, "{name}");
+            assert!(count(&culled, "casters-culled") > 0, "{name}");
         }
         assert_eq!(count(&plain, "super-tiles-culled"), 0, "{name}");
+        assert_eq!(count(&plain, "casters-culled"), 0, "{name}");
         if name == "interior" {
             // Measured 0.28 at 128x96 (issue 48 asks for below one half).
             let empty = count(&culled, "pairs-empty") as f64;

@@ -6,10 +6,18 @@
 // the triangle can shadow. A point light gives the triangle's own projection (section 3).
 // Conservative back-face culling for closed meshes (section 4.3, [ED07]): a triangle whose
 // supporting plane has the whole light on its front side is never a light back-facing caster.
+// The root of the view-sample cluster hierarchy: with cluster culling on, a caster whose
+// penumbra volume (`volume.wgsl`) misses the box of every ray origin of the batch shadows
+// none of them and gets no region (tally 18: casters culled), so `tiles.wgsl` numbers no tile
+// for it.
 
 @group(0) @binding(0) var<uniform> P: Params;
 @group(0) @binding(1) var<storage, read> casters: array<Caster>;
 @group(0) @binding(2) var<storage, read_write> regions: array<Region>;
+@group(0) @binding(3) var<storage, read> volumes: array<Volume>;
+// The box of the batch's ray origins: lower corner, then upper corner.
+@group(0) @binding(4) var<storage, read> batch_box: array<vec4<f32>, 2>;
+@group(0) @binding(5) var<storage, read_write> stats: array<atomic<u32>>;
 
 fn cross2(o: vec2<f32>, a: vec2<f32>, b: vec2<f32>) -> f32 {
     return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
@@ -100,6 +108,14 @@ fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n:
         return;
     }
     let tri = casters[t];
+    if P.options.w == 1u {
+        var vol = volumes[t];
+        if box_outside(&vol, batch_box[0].xyz, batch_box[1].xyz) {
+            culled(t);
+            add64(18u, 1u);
+            return;
+        }
+    }
     var v = array<vec3<f32>, 3>(tri.a, tri.b, tri.c);
     let nt = cross(v[1] - v[0], v[2] - v[0]);
     let closed = tri.closed == 1u;
