@@ -292,6 +292,7 @@ struct Occlusion<'a> {
     tile_near: &'a wgpu::Buffer,
     occupancy: &'a wgpu::Buffer,
     super_bounds: &'a wgpu::Buffer,
+    texel_bits: &'a wgpu::Buffer,
     batch_box: &'a wgpu::Buffer,
     slots: &'a wgpu::Buffer,
     texel_hidden: &'a wgpu::Buffer,
@@ -502,6 +503,7 @@ impl Occlusion<'_> {
                     self.tile_near,
                     self.occupancy,
                     &caster_masks,
+                    self.texel_bits,
                 ],
             );
             gpu.dispatch(&mut enc, &pipes.tile_pairs, &b, tiles.div_ceil(64))?;
@@ -645,6 +647,7 @@ pub fn run_batch(
         "batch box",
         &[[lo.x, lo.y, lo.z, 0.0], [hi.x, hi.y, hi.z, 0.0]],
     )?;
+    let texel_bits = gpu.storage_zeroed("occupied texels per tile", tiles_per_side.pow(2) * 8)?;
     let supers = tiles_per_side.div_ceil(4);
     let super_bounds = gpu.storage_zeroed("super-tile bounds", supers * supers * 32)?;
     // Per row of tiles, running counts of occupied tiles and their columns.
@@ -673,6 +676,7 @@ pub fn run_batch(
                 &texel_near,
                 &tile_near,
                 &super_bounds,
+                &texel_bits,
             ],
         );
         gpu.dispatch(&mut enc, &pipes.count, &b, groups)?;
@@ -722,6 +726,7 @@ pub fn run_batch(
         tile_near: &tile_near,
         occupancy: &occupancy,
         super_bounds: &super_bounds,
+        texel_bits: &texel_bits,
         batch_box: &batch_box,
         slots: &slots,
         texel_hidden: &texel_hidden,

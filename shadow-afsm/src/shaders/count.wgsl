@@ -20,6 +20,8 @@
 // Per super-tile of 4 x 4 tiles (`tiles.wgsl`): farthest depth, complement of the nearest,
 // then the six keys of its origin box.
 @group(0) @binding(10) var<storage, read_write> super_bounds: array<atomic<u32>>;
+// Per tile, two words of bits: its texels that hold a view sample (row-major).
+@group(0) @binding(11) var<storage, read_write> texel_bits: array<atomic<u32>>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n: vec3<u32>) {
@@ -43,6 +45,8 @@ fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n:
     atomicMax(&tile_depth[tile], z);
     atomicAdd(&tile_count[tile], 1u);
     atomicMax(&tile_near[tile], ~z);
+    let k = (ty % u32(TILE)) * u32(TILE) + tx % u32(TILE);
+    atomicOr(&texel_bits[2u * tile + k / 32u], 1u << (k % 32u));
     let supers = (tiles_per_side() + 3u) / 4u;
     let st = 8u * ((ty / u32(TILE) / 4u) * supers + tx / u32(TILE) / 4u);
     atomicMax(&super_bounds[st], z);

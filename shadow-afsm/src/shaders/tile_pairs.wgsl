@@ -48,6 +48,8 @@
 @group(0) @binding(13) var<storage, read> volumes: array<Volume>;
 @group(0) @binding(14) var<storage, read> texel_near: array<u32>;
 @group(0) @binding(15) var<storage, read> tile_near: array<u32>;
+// Per tile, its texels that hold a view sample (`count.wgsl`).
+@group(0) @binding(18) var<storage, read> texel_bits: array<u32>;
 // The map's occupied tiles (`occupancy.wgsl`), for `tile_of`.
 @group(0) @binding(16) var<storage, read> occupancy: array<u32>;
 // The super-tiles kept per caster of the range (`tiles.wgsl`), for `tile_of`.
@@ -258,8 +260,13 @@ fn main(@builtin(global_invocation_id) g: vec3<u32>, @builtin(num_workgroups) n:
     var hidden = 0u;
     var apart = 0u;
     var mask = vec2<u32>(0u);
-    // The cheap tests first, the hull (section 3.2's conservative rasterisation) last.
-    for (var k = 0u; k < 64u; k++) {
+    // The cheap tests first, the hull (section 3.2's conservative rasterisation) last, over
+    // the tile's texels that hold a view sample within the region's box.
+    var live = vec2<u32>(texel_bits[2u * tl.index], texel_bits[2u * tl.index + 1u]) & box_bits(tl);
+    for (var j = 0u; j < 64u && any(live != vec2<u32>(0u)); j++) {
+        let word = select(1u, 0u, live.x != 0u);
+        let k = 32u * word + firstTrailingBit(live[word]);
+        live[word] &= live[word] - 1u;
         let tt = tile_texel_list(tl, k);
         if tt.y > 0u {
             if culling && texel_hidden[tt.x] >= tt.y {

@@ -56,6 +56,24 @@ fn tile_of(u: u32) -> Tile {
     return Tile(t, y * tiles_per_side() + x, TILE * vec2<i32>(i32(x), i32(y)), bbox.xy, bbox.zw);
 }
 
+// The bits (row-major, two words) of a tile's texels inside the region's box.
+fn box_bits(tl: Tile) -> vec2<u32> {
+    let lo = clamp(tl.first - tl.origin, vec2<i32>(0), vec2<i32>(TILE));
+    let hi = clamp(tl.last - tl.origin + 1, vec2<i32>(0), vec2<i32>(TILE));
+    if any(hi <= lo) {
+        return vec2<u32>(0u);
+    }
+    // One row's bits (columns lo.x to hi.x - 1), then that row repeated over rows lo.y to
+    // hi.y - 1.
+    let row = ((1u << u32(hi.x - lo.x)) - 1u) << u32(lo.x);
+    var bits = vec2<u32>(0u);
+    for (var y = lo.y; y < hi.y; y++) {
+        let k = u32(y) * u32(TILE);
+        bits[k / 32u] |= row << (k % 32u);
+    }
+    return bits;
+}
+
 // Conservative rasterisation (section 3.2): texel (tx, ty) overlaps the hull of caster t.
 fn texel_overlaps(t: u32, tx: i32, ty: i32) -> bool {
     let info = regions[t].info;
