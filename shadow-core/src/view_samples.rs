@@ -165,6 +165,34 @@ impl ViewSamples {
         })
     }
 
+    /// Every `k`-th view sample each way: the view of [`RasterView::every_kth`], whose pixel
+    /// `(x, y)` holds this view's sample `(k x + k / 2, k y + k / 2)` (the same surface point
+    /// on the same camera ray), without rasterizing again. A technique chooser's low-resolution
+    /// look at the scene costs a copy, not a second view.
+    pub fn every_kth(&self, k: u32) -> Self {
+        let k = k.max(1);
+        let view = self.view.every_kth(k);
+        let (w, h) = (view.width, view.height);
+        let n = (w * h) as usize;
+        let source = |i: usize| {
+            let (x, y) = (i as u32 % w, i as u32 / w);
+            let sx = (k * x + k / 2).min(self.width - 1);
+            let sy = (k * y + k / 2).min(self.height - 1);
+            (sy * self.width + sx) as usize
+        };
+        Self {
+            width: w,
+            height: h,
+            camera_position: self.camera_position,
+            view,
+            position: (0..n).map(|i| self.position[source(i)]).collect(),
+            geometric_normal: (0..n).map(|i| self.geometric_normal[source(i)]).collect(),
+            shading_normal: (0..n).map(|i| self.shading_normal[source(i)]).collect(),
+            triangle: (0..n).map(|i| self.triangle[source(i)]).collect(),
+            depth: (0..n).map(|i| self.depth[source(i)]).collect(),
+        }
+    }
+
     /// Width in pixels.
     pub fn width(&self) -> u32 {
         self.width

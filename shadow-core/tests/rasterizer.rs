@@ -355,3 +355,39 @@ fn views_above_the_pixel_cap_are_refused_before_allocating() {
     let e = ViewSamples::render(setup.scene.as_ref(), &camera, u32::MAX, 2).unwrap_err();
     assert!(e.to_string().contains("largest supported view"), "{e}");
 }
+
+/// Every k-th view sample sits on its reduced view's pixel ray: the same camera rays (for odd
+/// and even k, and sizes that do not divide), so a technique given the reduced view (DCS
+/// rasterizes shadow volumes through its pixel centres) sees the same geometry.
+#[test]
+fn every_kth_view_sample_lies_on_its_reduced_pixel_ray() {
+    let setup = shadow_core::scenes::builtin("bunny").unwrap();
+    let full =
+        ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 67, 50).unwrap();
+    for k in [1u32, 2, 3, 4, 7] {
+        let small = full.every_kth(k);
+        assert_eq!((small.width(), small.height()), (67 / k, 50 / k), "k {k}");
+        let view = small.raster_view();
+        let mut checked = 0;
+        for y in 0..small.height() {
+            for x in 0..small.width() {
+                let s = small.get_at(x, y);
+                let f = full.get_at(k * x + k / 2, k * y + k / 2);
+                assert_eq!(
+                    s,
+                    f.map(|f| shadow_core::view_samples::ViewSample {
+                        pixel: glam::UVec2::new(x, y),
+                        ..f
+                    })
+                );
+                let Some(s) = s else { continue };
+                let (o, d) = view.pixel_ray(x, y);
+                let along = (s.position - o).dot(d);
+                let off = (s.position - o - along * d).length();
+                assert!(off <= 1e-5 * along.max(1.0), "k {k} ({x}, {y}): {off}");
+                checked += 1;
+            }
+        }
+        assert!(checked > 0, "k {k}");
+    }
+}

@@ -22,7 +22,6 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use shadow_core::prelude::*;
-use shadow_core::raster::RasterView;
 use shadow_dcs::{Dcs, PreparedDcs};
 use shadow_ref::AdaptiveReference;
 use shadow_ref::adaptive::{DEFAULT_BATCH, DEFAULT_CAP, PreparedAdaptive};
@@ -297,12 +296,9 @@ pub(super) fn probe_features(
         k += 1;
     }
     let t0 = std::time::Instant::now();
-    let low = RasterView {
-        width: (w / k).max(1) as u32,
-        height: (h / k).max(1) as u32,
-        ..*view.raster_view()
-    };
-    let small = ViewSamples::render_view(scene, &low)?;
+    // Every k-th view sample: the same surface points on the same camera rays, without
+    // rasterizing the scene again.
+    let small = view.every_kth(k as u32);
     // A view whose surfaces are too small for the reduced copy is probed at full size.
     let look = if small.valid_count() == 0 {
         probe.look(view, light)?

@@ -178,6 +178,47 @@ impl RasterView {
     pub fn depth_of(&self, p: Vec3) -> f32 {
         -self.view_from_world.transform_point3(p).z
     }
+
+    /// The view of `width / k` x `height / k` pixels (at least one each way) whose pixel
+    /// `(x, y)` has the centre ray of this view's pixel `(k x + k / 2, k y + k / 2)`, up to
+    /// rounding: the extents move by the blocks' offset and cover whole blocks of `k x k`
+    /// pixels. `k` of 0 counts as 1.
+    pub fn every_kth(&self, k: u32) -> RasterView {
+        let k = k.max(1);
+        let (w, h) = ((self.width / k).max(1), (self.height / k).max(1));
+        let (l, r, b, t, near, persp) = self.extents();
+        let (px, py) = ((r - l) / self.width as f32, (t - b) / self.height as f32);
+        // The block's chosen pixel centre lies `k / 2 + 1/2` pixels into it, the block's
+        // centre `k / 2`: the two differ by half a pixel for even `k`.
+        let shift = (k / 2) as f32 + 0.5 - 0.5 * k as f32;
+        let left = l + shift * px;
+        let top = t - shift * py;
+        let right = left + (w * k) as f32 * px;
+        let bottom = top - (h * k) as f32 * py;
+        let projection = if persp {
+            Projection::Perspective {
+                left,
+                right,
+                bottom,
+                top,
+                near,
+            }
+        } else {
+            Projection::Orthographic {
+                left,
+                right,
+                bottom,
+                top,
+                near,
+            }
+        };
+        RasterView {
+            width: w,
+            height: h,
+            projection,
+            ..*self
+        }
+    }
 }
 
 /// Calls `f(x, y)` for every pixel whose centre a world-space triangle covers in `view`, with
