@@ -2,7 +2,6 @@
 //! `cargo run --release -p shadow-ssm --example sm_bench -- SCENE [RESOLUTION] [REPEATS]`.
 use std::time::Instant;
 
-use glam::Vec2;
 use shadow_core::prelude::*;
 use shadow_ssm::light_frame::LightFrame;
 use shadow_ssm::light_view::LightView;
@@ -31,19 +30,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let t0 = Instant::now();
         let light = LightView::new(setup.scene.as_ref(), &frame);
         let t1 = Instant::now();
-        let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
-        let mut deepest = 0.0f32;
-        for p in &receivers {
-            let v = light.view_from_world.transform_point3(*p);
-            let d = -v.z;
-            if d > light.near {
-                let q = Vec2::new(v.x / d, v.y / d);
-                lo = lo.min(q);
-                hi = hi.max(q);
-                deepest = deepest.max(d);
-            }
-        }
-        let window = light.window(setup.scene.triangles(), lo, hi, deepest);
+        let window = ShadowMap::window(setup.scene.as_ref(), &light, &receivers)
+            .ok_or("no receiver in front of the light")?;
         let t2 = Instant::now();
         let m = ShadowMap::render_view(setup.scene.as_ref(), light.raster_view(window, res), 1)?;
         let t3 = Instant::now();

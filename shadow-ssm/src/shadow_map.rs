@@ -48,6 +48,18 @@ impl ShadowMap {
         layers: u32,
     ) -> Result<Option<Self>, RasterError> {
         let light = LightView::new(scene, frame);
+        let Some(window) = Self::window(scene, &light, receivers) else {
+            return Ok(None);
+        };
+        let mut map = Self::render_view(scene, light.raster_view(window, resolution), layers)?;
+        map.window = window;
+        Ok(Some(map))
+    }
+
+    /// The window of the map for `receivers` (world positions) seen from `light`: their
+    /// projections at unit depth widened to hold every surface that can shadow them
+    /// ([`LightView::window`]); `None` when no receiver lies in front of the light.
+    pub fn window(scene: &dyn Scene, light: &LightView, receivers: &[Vec3]) -> Option<Window> {
         let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
         let mut deepest = 0.0f32;
         for p in receivers {
@@ -60,13 +72,7 @@ impl ShadowMap {
                 deepest = deepest.max(d);
             }
         }
-        if !(lo.x <= hi.x) {
-            return Ok(None);
-        }
-        let window = light.window(scene.triangles(), lo, hi, deepest);
-        let mut map = Self::render_view(scene, light.raster_view(window, resolution), layers)?;
-        map.window = window;
-        Ok(Some(map))
+        (lo.x <= hi.x).then(|| light.window(scene.triangles(), lo, hi, deepest))
     }
 
     /// Renders the map of `scene` through the square light-centre frustum `view`.
