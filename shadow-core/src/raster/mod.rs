@@ -440,43 +440,58 @@ pub fn rasterize_depth(
 
 /// Sets up `triangles` in chunks, in order (an equal depth keeps the earlier triangle), so
 /// that the set-up data held at once stays bounded (set up whole, 8 million triangles took
-/// 3 GB), bins each chunk's pieces by band of rows and hands them to `scan`.
+/// 3 GB), bins each chunk's pieces by band of rows and hands them to `scan`. Each triangle's
+/// pieces (none, or up to two after near-plane clipping) stay where its set-up put them: the
+/// chunk's list is collected in place, and a bin entry is `2 * triangle + piece`.
 fn scan_chunks(
     positions: &[Vec3],
     triangles: &[[u32; 3]],
     view: &RasterView,
-    mut scan: impl FnMut(&[(u32, ScreenTriangle)], &[Vec<u32>]),
+    mut scan: impl FnMut(&Pieces, &[Vec<u32>]),
 ) {
     let bands = view.height.div_ceil(BAND) as usize;
     for (c, chunk) in triangles.chunks(RASTER_CHUNK).enumerate() {
         let first = (c * RASTER_CHUNK) as u32;
         // Set-up in parallel; only the pieces that reach a pixel are kept.
-        let setups: Vec<(u32, ScreenTriangle)> = chunk
+        let setups: Vec<Vec<ScreenTriangle>> = chunk
             .par_iter()
-            .enumerate()
-            .flat_map_iter(|(i, tri)| {
+            .map(|tri| {
                 let v = tri.map(|i| view.view_from_world.transform_point3(positions[i as usize]));
                 setup_triangle(v, view)
-                    .into_iter()
-                    .map(move |s| (first + i as u32, s))
             })
             .collect();
         // Binning in triangle order.
         let mut bins: Vec<Vec<u32>> = vec![Vec::new(); bands];
-        for (n, (_, s)) in setups.iter().enumerate() {
-            let (y0, y1) = (s.ymin / BAND, s.ymax / BAND);
-            for bin in bins.iter_mut().take(y1 as usize + 1).skip(y0 as usize) {
-                bin.push(n as u32);
+        for (n, pieces) in setups.iter().enumerate() {
+            for (k, s) in pieces.iter().enumerate() {
+                let (y0, y1) = (s.ymin / BAND, s.ymax / BAND);
+                for bin in bins.iter_mut().take(y1 as usize + 1).skip(y0 as usize) {
+                    bin.push(2 * n as u32 + k as u32);
+                }
             }
         }
-        scan(&setups, &bins);
+        scan(&Pieces { first, setups }, &bins);
+    }
+}
+
+/// A chunk's set-up triangles: per triangle its pieces, the first triangle's id `first`.
+struct Pieces {
+    first: u32,
+    setups: Vec<Vec<ScreenTriangle>>,
+}
+
+impl Pieces {
+    /// The triangle id and set-up of bin entry `n`.
+    fn get(&self, n: u32) -> (u32, &ScreenTriangle) {
+        let t = (n / 2) as usize;
+        (self.first + t as u32, &self.setups[t][(n % 2) as usize])
     }
 }
 
 /// Scan-converts the pieces `bin` of `setups` within band `band` of rows, in order, handing
 /// each covered pixel's index within the band, triangle and depth to `put`.
 fn scan_band(
-    setups: &[(u32, ScreenTriangle)],
+    setups: &Pieces,
     bin: &[u32],
     band: u32,
     view: &RasterView,
@@ -486,7 +501,7 @@ fn scan_band(
     let y_lo = band * BAND;
     let y_hi = (y_lo + BAND).min(view.height);
     for &n in bin {
-        let (t, s) = &setups[n as usize];
+        let (t, s) = setups.get(n);
         let ys = s.ymin.max(y_lo);
         let ye = s.ymax.min(y_hi - 1);
         // Wide boxes take each row's covered run (the same pixels as the test at every
@@ -506,7 +521,7 @@ fn scan_band(
                 let Some(d) = s.depth_at_center(x, y) else {
                     continue;
                 };
-                put(((y - y_lo) * w + x) as usize, *t, d);
+                put(((y - y_lo) * w + x) as usize, t, d);
             }
         }
     }

@@ -326,7 +326,10 @@ fn edge_rows(a: DVec2, c: DVec2) -> (bool, (f64, f64, f64)) {
 pub(super) fn setup_triangle(v: [Vec3; 3], view: &RasterView) -> Vec<ScreenTriangle> {
     let persp = view.extents().5;
     let projected = clip_and_project(&v, view);
-    let mut out = Vec::with_capacity(2);
+    // Allocated at the first piece, for the pieces left: a triangle that reaches no pixel
+    // centre (most of a dense mesh's, in a small view) allocates nothing, and the rasterizer
+    // keeps each triangle's list until its chunk is scanned.
+    let mut out = Vec::new();
     for i in 1..projected.len().saturating_sub(1) {
         let mut tri = [projected[0], projected[i], projected[i + 1]];
         let mut area = edge(tri[0].0, tri[1].0, tri[2].0);
@@ -343,6 +346,9 @@ pub(super) fn setup_triangle(v: [Vec3; 3], view: &RasterView) -> Vec<ScreenTrian
         };
         let rows: [(bool, (f64, f64, f64)); 3] =
             std::array::from_fn(|i| edge_rows(p[i], p[(i + 1) % 3]));
+        if out.is_empty() {
+            out.reserve_exact(projected.len() - 1 - i);
+        }
         out.push(ScreenTriangle {
             p,
             z: [tri[0].1, tri[1].1, tri[2].1],
