@@ -21,7 +21,8 @@
 //!   on a planar light so the exact test visits only those a triangle's projection covers.
 //! * [`technique`]: the [`Afsm`] technique (hard shadows of section 3 and soft shadows of
 //!   section 4 with N = 1 to 1024 samples), [`temporal`]: temporal jittering (Fig. 7).
-//! * [`params`]: the data layout shared with the shaders.
+//! * [`params`]: the data layout shared with the shaders; [`pipelines`]: the passes' WGSL and
+//!   their compiled pipelines.
 //!
 //! The GPU comes from `shadow-core`'s `gpu` feature: the adapter is chosen from
 //! `WGPU_BACKEND` and `WGPU_ADAPTER_NAME`, with the software Vulkan adapter (lavapipe) as the
@@ -57,6 +58,7 @@ mod inputs;
 pub mod lut;
 pub mod params;
 pub mod passes;
+pub mod pipelines;
 mod presets;
 pub mod sample_grid;
 pub mod technique;
