@@ -4,6 +4,8 @@
 //! GBP07 uses to shrink the kernel of eq. 1 until it converges and to classify a receiver as lit,
 //! umbra or penumbra before any exact work.
 
+use std::sync::Arc;
+
 use rayon::prelude::*;
 
 use crate::shadow_map::ShadowMap;
@@ -12,16 +14,16 @@ use crate::shadow_map::ShadowMap;
 #[derive(Debug, Clone)]
 pub struct MinMaxPyramid {
     /// Per level: side in blocks, min depths, max depths (row-major; the max is empty at level
-    /// 0, whose max is its min).
-    levels: Vec<(usize, Vec<f32>, Vec<f32>)>,
+    /// 0, whose max is its min). Level 0 is the shadow map's own depths, shared.
+    levels: Vec<(usize, Arc<Vec<f32>>, Vec<f32>)>,
 }
 
 impl MinMaxPyramid {
     /// Builds the pyramid of a shadow map.
     pub fn build(sm: &ShadowMap) -> Self {
         let r = sm.view.width as usize;
-        // Level 0 is the map itself, min and max alike: one copy, read as both.
-        let mut levels = vec![(r, sm.depth.clone(), Vec::new())];
+        // Level 0 is the map itself, min and max alike: shared, read as both.
+        let mut levels = vec![(r, Arc::clone(&sm.depth), Vec::new())];
         while levels.last().is_some_and(|l| l.0 > 1) {
             let (side, lo, hi) = levels.last().expect("non-empty");
             let hi = if hi.is_empty() { lo } else { hi };
@@ -46,7 +48,7 @@ impl MinMaxPyramid {
                         }
                     }
                 });
-            levels.push((next, nlo, nhi));
+            levels.push((next, Arc::new(nlo), nhi));
         }
         Self { levels }
     }
@@ -210,10 +212,11 @@ mod tests {
         // A map at depth 8 everywhere but one occluder texel block at depth 2.
         let r = 64u32;
         let mut sm = random_map(r);
-        sm.depth.iter_mut().for_each(|d| *d = 8.0);
+        let depth = Arc::make_mut(&mut sm.depth);
+        depth.iter_mut().for_each(|d| *d = 8.0);
         for y in 40..44 {
             for x in 40..44 {
-                sm.depth[(y * r + x) as usize] = 2.0;
+                depth[(y * r + x) as usize] = 2.0;
             }
         }
         sm.min_depth = 2.0;

@@ -5,6 +5,8 @@
 //! The frustum is fitted to the view samples that can see the light, widened so that every
 //! occluder able to shadow them is inside ([`crate::light_view`]).
 
+use std::sync::Arc;
+
 use glam::{Vec2, Vec3};
 use shadow_core::raster::{RasterError, RasterView, rasterize_depth};
 use shadow_core::scene::Scene;
@@ -18,7 +20,8 @@ pub struct ShadowMap {
     /// The light's frustum.
     pub view: RasterView,
     /// Linear depth per texel (infinite where nothing was drawn), row-major, row 0 on top.
-    pub depth: Vec<f32>,
+    /// Shared, not copied, with level 0 of the min/max pyramid built on it.
+    pub depth: Arc<Vec<f32>>,
     /// Texels per unit of unit-depth coordinates (`r / w_n * z_n` of GBP07 eq. 1).
     pub texels_per_unit: f64,
     /// Smallest depth stored (the top of GBP07's hierarchical shadow map).
@@ -98,7 +101,7 @@ impl ShadowMap {
         };
         let min_depth = first.iter().copied().fold(f32::INFINITY, f32::min);
         Ok(Self {
-            depth: first,
+            depth: Arc::new(first),
             layers,
             layered,
             texels_per_unit: resolution as f64 / (right as f64 - left as f64),
@@ -205,7 +208,7 @@ impl ShadowMap {
                     near: 0.1,
                 },
             },
-            depth,
+            depth: Arc::new(depth),
             texels_per_unit: r as f64 / 2.0,
             min_depth,
             layers: 1,

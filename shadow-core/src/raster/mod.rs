@@ -390,14 +390,21 @@ pub fn rasterize(
             .zip(depth_out.par_chunks_mut(band_len))
             .enumerate()
             .for_each(|(band, (tri_band, depth_band))| {
-                scan_band(setups, &bins[band], band as u32, view, |base, t, d| {
-                    insert_layer(
-                        &mut tri_band[base * k..(base + 1) * k],
-                        &mut depth_band[base * k..(base + 1) * k],
-                        t,
-                        d,
-                    );
-                });
+                scan_band(
+                    setups,
+                    &bins[band],
+                    band as u32,
+                    view,
+                    false,
+                    |base, t, d| {
+                        insert_layer(
+                            &mut tri_band[base * k..(base + 1) * k],
+                            &mut depth_band[base * k..(base + 1) * k],
+                            t,
+                            d,
+                        );
+                    },
+                );
             });
     });
     Ok(Fragments {
@@ -430,9 +437,25 @@ pub fn rasterize_depth(
             .par_chunks_mut(band_len)
             .enumerate()
             .for_each(|(band, depth_band)| {
-                scan_band(setups, &bins[band], band as u32, view, |base, _, d| {
-                    insert_depth(&mut depth_band[base * k..(base + 1) * k], d);
-                });
+                scan_band(
+                    setups,
+                    &bins[band],
+                    band as u32,
+                    view,
+                    true,
+                    |base, _, d| {
+                        if k == 1 {
+                            // One layer: the nearest depth ([`insert_depth`] on one slot; `d` is
+                            // finite, so an equal depth keeps the earlier fragment alike).
+                            let slot = &mut depth_band[base];
+                            if d < *slot {
+                                *slot = d;
+                            }
+                        } else {
+                            insert_depth(&mut depth_band[base * k..(base + 1) * k], d);
+                        }
+                    },
+                );
             });
     });
     Ok(depth_out)
@@ -489,12 +512,17 @@ impl Pieces {
 }
 
 /// Scan-converts the pieces `bin` of `setups` within band `band` of rows, in order, handing
-/// each covered pixel's index within the band, triangle and depth to `put`.
+/// each covered pixel's index within the band, triangle and depth to `put`. With `plane`, the
+/// pixels of a wide triangle's covered runs take their depth from its plane
+/// ([`setup::ScreenTriangle::depth_on_plane`]): the shadow maps, whose f32 depths it leaves
+/// as they were on every map compared (`rasterize_depth_matches_rasterize`'s scenes); the
+/// view keeps the barycentric form, which every technique's view samples come from.
 fn scan_band(
     setups: &Pieces,
     bin: &[u32],
     band: u32,
     view: &RasterView,
+    plane: bool,
     mut put: impl FnMut(usize, u32, f32),
 ) {
     let w = view.width;
@@ -508,6 +536,7 @@ fn scan_band(
         // centre, [`setup::ConvexRows::row_span`]); narrow ones test every pixel, cheaper
         // than finding the run.
         let wide = s.xmax - s.xmin >= SPAN_MIN_WIDTH;
+        let gradient = (wide && plane).then(|| s.depth_gradient());
         for y in ys..=ye {
             let (x0, x1) = if wide {
                 match s.row_span(y) {
@@ -517,6 +546,14 @@ fn scan_band(
             } else {
                 (s.xmin, s.xmax)
             };
+            if let Some(g) = gradient {
+                for x in x0..=x1 {
+                    if let Some(d) = s.depth_on_plane(g, x, y) {
+                        put(((y - y_lo) * w + x) as usize, t, d);
+                    }
+                }
+                continue;
+            }
             for x in x0..=x1 {
                 let Some(d) = s.depth_at_center(x, y) else {
                     continue;

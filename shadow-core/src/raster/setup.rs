@@ -64,6 +64,30 @@ impl ScreenTriangle {
         Some(w)
     }
 
+    /// The depth term's plane over the screen, relative to vertex 0: `(dz/dx, dz/dy)`, so
+    /// that the term at `c` is `z[0] + g.x (c.x - p[0].x) + g.y (c.y - p[0].y)`. The same
+    /// plane the barycentric weights interpolate, rounded differently in the last f64 bits
+    /// (the depth is then rounded to f32); relative to a vertex, so the terms stay of the
+    /// size of the triangle's own depth range.
+    pub fn depth_gradient(&self) -> DVec2 {
+        let (p, z) = (&self.p, &self.z);
+        let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+        let (dz1, dz2) = (z[1] - z[0], z[2] - z[0]);
+        DVec2::new(dz1 * e2.y - dz2 * e1.y, dz2 * e1.x - dz1 * e2.x) / self.area
+    }
+
+    /// The depth of a pixel known to be covered (one of a [`ConvexRows::row_span`] run) from
+    /// the plane `g` ([`ScreenTriangle::depth_gradient`]): one division where
+    /// [`ScreenTriangle::depth_at_center`] takes four and three edge functions.
+    #[inline]
+    pub fn depth_on_plane(&self, g: DVec2, x: u32, y: u32) -> Option<f32> {
+        let c = DVec2::new(x as f64 + 0.5, y as f64 + 0.5) - self.p[0];
+        let zi = self.z[0] + g.x * c.x + g.y * c.y;
+        let d = if self.perspective { 1.0 / zi } else { zi };
+        let d = d as f32;
+        d.is_finite().then_some(d)
+    }
+
     /// Linear depth at the centre of pixel `(x, y)` when covered.
     pub fn depth_at_center(&self, x: u32, y: u32) -> Option<f32> {
         let w = self.weights_at(x, y)?;

@@ -380,3 +380,58 @@ fn covered_polygons_equal_their_fan_triangles() {
     assert!(shared > 50, "{shared}");
     assert!(on_edge > 20, "{on_edge} pixels on a shared edge");
 }
+
+/// The depth from a triangle's plane ([`setup::ScreenTriangle::depth_on_plane`], the shadow
+/// maps' runs) is the barycentric depth ([`setup::ScreenTriangle::depth_at_center`]) to f32
+/// rounding on every covered pixel, slivers and triangles cut by the near plane included.
+#[test]
+fn plane_depths_equal_barycentric_depths() {
+    let view = persp_view();
+    let r = |k: u64, i: u64| {
+        crate::sampling::unit_float(crate::sampling::hash_words(&[k, i, 7])) * 2.0 - 1.0
+    };
+    let sliver = [
+        Vec3::new(-2.0, -1.0, -3.0),
+        Vec3::new(2.0, 1.0, -3.5),
+        Vec3::new(2.0, 1.01, -2.5),
+    ];
+    let (mut pixels, mut equal) = (0usize, 0usize);
+    for (k, tri) in (0..300u64)
+        .map(|k| {
+            std::array::from_fn(|v| {
+                let v = v as u64;
+                Vec3::new(
+                    r(k, 3 * v) * 2.0,
+                    r(k, 3 * v + 1) * 2.0,
+                    -2.0 + 1.8 * r(k, 3 * v + 2),
+                )
+            })
+        })
+        .chain([sliver])
+        .enumerate()
+    {
+        let v = tri.map(|p| view.view_from_world.transform_point3(p));
+        for s in setup::setup_triangle(v, &view) {
+            let g = s.depth_gradient();
+            for y in s.ymin..=s.ymax {
+                for x in s.xmin..=s.xmax {
+                    let Some(d) = s.depth_at_center(x, y) else {
+                        continue;
+                    };
+                    let p = s
+                        .depth_on_plane(g, x, y)
+                        .expect("a covered pixel has a depth");
+                    assert!(
+                        (p - d).abs() <= 2.0 * f32::EPSILON * d.abs(),
+                        "{k}: {p} {d}"
+                    );
+                    pixels += 1;
+                    equal += usize::from(p == d);
+                }
+            }
+        }
+    }
+    assert!(pixels > 10_000, "{pixels}");
+    // Rounded to f32, the two f64 forms almost never differ.
+    assert!(equal as f64 > 0.999 * pixels as f64, "{equal} of {pixels}");
+}
