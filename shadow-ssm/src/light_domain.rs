@@ -8,7 +8,10 @@
 //!   contour edge adds or removes the part of the light inside the wedge its end points span
 //!   from the centre and beyond the edge ([`LightDomain::edge`], Fig. 5a, as penumbra wedges
 //!   do, ADMAM03). The region is the light clipped by three half-planes, so any simple
-//!   polygon light works, convex or not.
+//!   polygon light works, convex or not. An outline of many vertices that is star-shaped
+//!   from the centre (a disk's 64-gon) first takes the wedge as a fan of the few vertices
+//!   inside it, found by a binary search over their angles, and is clipped by the third
+//!   half-plane only: the same region, without two passes over the whole outline.
 //! * Textured rectangle lights (GBP07 section 8: edge integration fits textured planar lights)
 //!   weight each region by the radiance over it: Green's theorem turns the area integral into
 //!   the boundary integral of `F(u, v) = ∫_0^u L(s, v) ds`, tabulated on the light's uv square
@@ -54,8 +57,107 @@ pub struct LightDomain {
     /// whose sides follow the map's axes): its rectangles are then clipped by two comparisons.
     bounds: (DVec2, DVec2),
     is_box: bool,
+    /// The outline's vertex angles around the centre, when it is star-shaped from it with
+    /// many vertices (a disk's 64-gon): [`LightDomain::edge`] then takes the few vertices
+    /// inside an edge's wedge instead of clipping the whole outline.
+    fan: Option<Fan>,
     texture: Option<RadianceTable>,
     full: Covered,
+}
+
+/// Outlines with more vertices than this are integrated by fans (see [`Fan`]); a rectangle's
+/// four are cheaper to clip whole.
+const FAN_MIN_VERTICES: usize = 8;
+
+/// A star-shaped outline seen from the light's centre: its vertices counter-clockwise, each
+/// edge turning counter-clockwise around the centre, once around in all. Every ray from the
+/// centre then leaves the light through exactly one edge, and the light inside the wedge
+/// between two directions is the fan of the centre, the two rays' exit points and the
+/// vertices between them: the same region as the outline clipped by the wedge's two
+/// half-planes, found by a binary search instead of two passes over the outline.
+#[derive(Debug, Clone)]
+struct Fan {
+    /// Vertices, counter-clockwise.
+    points: Vec<DVec2>,
+    /// Each vertex's [`pseudo_angle`] from vertex 0's, increasing from 0 within `0..4`.
+    turns: Vec<f64>,
+}
+
+/// A number in `0..4` that increases with the direction's angle counter-clockwise from +x
+/// (the "diamond angle"): it orders directions as their angles do, without a trigonometric
+/// function.
+fn pseudo_angle(d: DVec2) -> f64 {
+    let p = d.y / (d.x.abs() + d.y.abs());
+    if d.x >= 0.0 {
+        if d.y >= 0.0 { p } else { 4.0 + p }
+    } else {
+        2.0 - p
+    }
+}
+
+impl Fan {
+    /// The fan of `points` (either orientation) when it is star-shaped from the origin.
+    fn new(points: &[DVec2]) -> Option<Self> {
+        let mut points = points.to_vec();
+        if polygon_area(&points) < 0.0 {
+            points.reverse();
+        }
+        let n = points.len();
+        let start = pseudo_angle(points[0]);
+        let mut turned = 0.0;
+        for i in 0..n {
+            let (p, q) = (points[i], points[(i + 1) % n]);
+            if !(p.perp_dot(q) > 0.0) {
+                return None;
+            }
+            turned += p.perp_dot(q).atan2(p.dot(q));
+        }
+        // Once around the centre, not twice.
+        if (turned - std::f64::consts::TAU).abs() > 1e-9 {
+            return None;
+        }
+        let turns: Vec<f64> = points
+            .iter()
+            .map(|&p| (pseudo_angle(p) - start).rem_euclid(4.0))
+            .collect();
+        turns
+            .windows(2)
+            .all(|w| w[0] < w[1])
+            .then_some(Self { points, turns })
+    }
+
+    /// Where the ray from the origin along `d` leaves the outline through the edge from
+    /// vertex `i`.
+    fn exit(&self, i: usize, d: DVec2) -> DVec2 {
+        let p = self.points[i];
+        let e = self.points[(i + 1) % self.points.len()] - p;
+        d * (p.perp_dot(e) / d.perp_dot(e))
+    }
+
+    /// Writes into `poly` the light inside the wedge from `a` counter-clockwise to `b` (less
+    /// than half a turn).
+    fn wedge(&self, a: DVec2, b: DVec2, poly: &mut Vec<DVec2>) {
+        let n = self.points.len();
+        // The edge `a`'s ray leaves through: the last vertex at or before its direction.
+        let t = (pseudo_angle(a) - pseudo_angle(self.points[0])).rem_euclid(4.0);
+        let i = self.turns.partition_point(|&x| x <= t).max(1) - 1;
+        poly.clear();
+        poly.push(DVec2::ZERO);
+        poly.push(self.exit(i, a));
+        // The vertices strictly before `b`'s direction, in order: consecutive vertices turn
+        // by less than half a turn and the wedge spans less than one, so the first vertex
+        // not before `b` ends them.
+        let mut last = i;
+        for j in i + 1..i + 1 + n {
+            let k = j % n;
+            if !(self.points[k].perp_dot(b) > 0.0) {
+                break;
+            }
+            poly.push(self.points[k]);
+            last = k;
+        }
+        poly.push(self.exit(last, b));
+    }
 }
 
 impl LightDomain {
@@ -68,9 +170,13 @@ impl LightDomain {
         let box_area = (hi - lo).x * (hi - lo).y;
         // A convex outline with its bounding box's area is that box.
         let is_box = area > 0.0 && (box_area - area).abs() <= 1e-12 * box_area;
+        let fan = (points.len() > FAN_MIN_VERTICES)
+            .then(|| Fan::new(&points))
+            .flatten();
         Self {
             bounds: (lo, hi),
             is_box,
+            fan,
             full: Covered {
                 area,
                 radiance: DVec3::ZERO,
@@ -244,10 +350,16 @@ impl LightDomain {
         };
         // Now a -> b turns counter-clockwise: the wedge is {x: a x x >= 0, x x b >= 0}; beyond
         // the edge is the side of line ab away from the origin.
-        poly.clear();
-        poly.extend_from_slice(&self.points);
         let beyond = DVec2::new(b.y - a.y, a.x - b.x); // right normal of a -> b
-        for (n, c) in [(a.perp(), 0.0), (-b.perp(), 0.0), (beyond, beyond.dot(a))] {
+        let wedge = if let Some(fan) = &self.fan {
+            fan.wedge(a, b, poly);
+            &[][..]
+        } else {
+            poly.clear();
+            poly.extend_from_slice(&self.points);
+            &[(a.perp(), 0.0), (-b.perp(), 0.0)][..]
+        };
+        for &(n, c) in wedge.iter().chain(&[(beyond, beyond.dot(a))]) {
             clip(poly, scratch, n, c);
             if poly.len() < 3 {
                 return Covered::default();
@@ -397,6 +509,54 @@ mod tests {
     use super::*;
     use glam::Vec3;
     use shadow_core::light::{Radiance, RectLight, TexturedRadiance};
+
+    /// A fan-integrated outline (a disk's 64-gon, an off-centre star-shaped 12-gon, either
+    /// orientation) gives every edge the area of the whole outline clipped by the wedge,
+    /// and a closed contour around the centre the whole light.
+    #[test]
+    fn fan_edges_equal_clipped_outline_edges() {
+        let disk: Vec<Vec2> = (0..64)
+            .map(|k| {
+                let t = std::f32::consts::TAU * k as f32 / 64.0;
+                Vec2::new(0.7 * t.cos() + 0.05, 0.7 * t.sin() - 0.1)
+            })
+            .collect();
+        let star: Vec<Vec2> = (0..12)
+            .rev()
+            .map(|k| {
+                let t = std::f32::consts::TAU * k as f32 / 12.0;
+                let r = if k % 2 == 0 { 1.0 } else { 0.45 };
+                Vec2::new(r * t.cos() + 0.1, r * t.sin())
+            })
+            .collect();
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.4 - 1.2
+        };
+        for outline in [disk, star] {
+            let fan = LightDomain::new(&outline);
+            assert!(fan.fan.is_some());
+            let mut whole = fan.clone();
+            whole.fan = None;
+            let (mut poly, mut scratch) = (Vec::new(), Vec::new());
+            for _ in 0..20_000 {
+                let (a, b) = (DVec2::new(next(), next()), DVec2::new(next(), next()));
+                let got = fan.edge(a, b, &mut poly, &mut scratch).area;
+                let want = whole.edge(a, b, &mut poly, &mut scratch).area;
+                assert!((got - want).abs() <= 1e-12, "{a} {b}: {got} {want}");
+            }
+            // A square contour around the centre, counter-clockwise, hides the light inside it.
+            let c =
+                [(-2.0, -2.0), (2.0, -2.0), (2.0, 2.0), (-2.0, 2.0)].map(|(x, y)| DVec2::new(x, y));
+            let total: f64 = (0..4)
+                .map(|i| fan.edge(c[i], c[(i + 1) % 4], &mut poly, &mut scratch).area)
+                .sum();
+            assert!(total.abs() < 1e-12, "{total}");
+        }
+    }
 
     fn square() -> LightDomain {
         LightDomain::new(&[

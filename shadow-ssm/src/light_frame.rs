@@ -78,6 +78,16 @@ impl LightFrame {
         let (t1, t2) = (self.basis.0.as_dvec3(), self.basis.1.as_dvec3());
         let c = self.center.as_dvec3();
         let side = |q: DVec3| (q - p.as_dvec3()).dot(n.as_dvec3());
+        // Most receivers see the whole light or none of it: then the clip would keep every
+        // point or none, and the fraction is 1 or 0 without it (the same values).
+        let above = self
+            .outline
+            .iter()
+            .filter(|v| side(v.as_dvec3()) > 0.0)
+            .count();
+        if above == 0 {
+            return 0.0;
+        }
         let pts: Vec<DVec3> = self.outline.iter().map(|v| v.as_dvec3()).collect();
         let area = |poly: &[DVec3]| -> f64 {
             let m = poly.len();
@@ -91,6 +101,9 @@ impl LightFrame {
         let total = area(&pts);
         if !(total > 0.0) {
             return 0.0;
+        }
+        if above == pts.len() {
+            return 1.0;
         }
         // Sutherland-Hodgman against the half-space side > 0.
         let mut clipped = Vec::with_capacity(pts.len() + 2);
