@@ -333,6 +333,7 @@ pub fn run(mut a: BenchArgs) -> Result<(), String> {
     }
     pb.finish_and_clear();
     write_summary(&a, &points, truth_samples)?;
+    write_points(&a, &m, &points, truth_samples)?;
     if a.study_only {
         return Ok(());
     }
@@ -454,28 +455,7 @@ pub fn run(mut a: BenchArgs) -> Result<(), String> {
         100.0 * query.occluded_share
     );
 
-    // Files.
-    let mut csv = format!(
-        "# {} | {} threads | {} | {}x{} | ground truth: reference at {truth_samples} samples\nscene,technique,samples,rmse,penumbra_rmse,flip,bias,max_abs,seconds_median\n",
-        m.cpu, m.threads, m.date, a.width, a.height
-    );
-    for p in &points {
-        writeln!(
-            csv,
-            "{},{},{},{:.6},{},{:.6},{:.6},{:.5},{:.5}",
-            p.scene,
-            p.technique,
-            p.samples.map_or(String::new(), |s| s.to_string()),
-            p.rmse,
-            p.penumbra_rmse.map_or(String::new(), |v| format!("{v:.6}")),
-            p.flip,
-            p.bias,
-            p.max_abs,
-            p.seconds
-        )
-        .ok();
-    }
-    std::fs::write(a.out.join("bench.csv"), csv).map_err(|e| e.to_string())?;
+    // Files (bench.csv is written with the study).
     let mut csv = format!(
         "# {} | {} threads | {}\nsweep,technique,x,seconds_median,triangles,valid_pixels\n",
         m.cpu, m.threads, m.date
@@ -744,5 +724,37 @@ fn write_summary(a: &BenchArgs, points: &[Point], truth_samples: u32) -> Result<
         write_docs(page, &md)?;
         println!("wrote the summary into {}", page.display());
     }
+    Ok(())
+}
+
+/// Writes every time-error point of the study to `bench.csv` (scene, technique, samples, RMSE,
+/// penumbra RMSE, FLIP, bias, largest error, median seconds).
+fn write_points(
+    a: &BenchArgs,
+    m: &crate::common::Machine,
+    points: &[Point],
+    truth_samples: u32,
+) -> Result<(), String> {
+    let mut csv = format!(
+        "# {} | {} threads | {} | {}x{} | ground truth: reference at {truth_samples} samples\nscene,technique,samples,rmse,penumbra_rmse,flip,bias,max_abs,seconds_median\n",
+        m.cpu, m.threads, m.date, a.width, a.height
+    );
+    for p in points {
+        writeln!(
+            csv,
+            "{},{},{},{:.6},{},{:.6},{:.6},{:.5},{:.5}",
+            p.scene,
+            p.technique,
+            p.samples.map_or(String::new(), |s| s.to_string()),
+            p.rmse,
+            p.penumbra_rmse.map_or(String::new(), |v| format!("{v:.6}")),
+            p.flip,
+            p.bias,
+            p.max_abs,
+            p.seconds
+        )
+        .ok();
+    }
+    std::fs::write(a.out.join("bench.csv"), csv).map_err(|e| e.to_string())?;
     Ok(())
 }
