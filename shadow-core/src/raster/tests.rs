@@ -127,14 +127,14 @@ fn ortho_view() -> RasterView {
 
 /// Visiting a triangle band by band reports the same pixels, once each, as one visit of
 /// the whole image, a triangle clipped by the near plane included.
-#[test]
-fn covered_pixels_by_bands_equal_the_whole_visit() {
-    let view = persp_view();
-    // Random triangles too, some crossing the near plane, some thin.
-    let r = |k: u64, i: u64| {
-        crate::sampling::unit_float(crate::sampling::hash_words(&[k, i])) * 2.0 - 1.0
+/// 300 random triangles in front of [`persp_view`]'s eye, some crossing the near plane, some
+/// thin; `salt` picks another set.
+fn random_triangles(salt: &[u64]) -> impl Iterator<Item = [Vec3; 3]> + '_ {
+    let r = move |k: u64, i: u64| {
+        let words: Vec<u64> = [k, i].iter().chain(salt).copied().collect();
+        crate::sampling::unit_float(crate::sampling::hash_words(&words)) * 2.0 - 1.0
     };
-    let random = (0..300u64).map(|k| {
+    (0..300u64).map(move |k| {
         std::array::from_fn(|v| {
             let v = v as u64;
             Vec3::new(
@@ -143,7 +143,14 @@ fn covered_pixels_by_bands_equal_the_whole_visit() {
                 -2.0 + 1.8 * r(k, 3 * v + 2),
             )
         })
-    });
+    })
+}
+
+#[test]
+fn covered_pixels_by_bands_equal_the_whole_visit() {
+    let view = persp_view();
+    // Random triangles too, some crossing the near plane, some thin.
+    let random = random_triangles(&[]);
     let fixed = [
         [
             Vec3::new(-3.0, -2.0, -4.0),
@@ -387,29 +394,13 @@ fn covered_polygons_equal_their_fan_triangles() {
 #[test]
 fn plane_depths_equal_barycentric_depths() {
     let view = persp_view();
-    let r = |k: u64, i: u64| {
-        crate::sampling::unit_float(crate::sampling::hash_words(&[k, i, 7])) * 2.0 - 1.0
-    };
     let sliver = [
         Vec3::new(-2.0, -1.0, -3.0),
         Vec3::new(2.0, 1.0, -3.5),
         Vec3::new(2.0, 1.01, -2.5),
     ];
     let (mut pixels, mut equal) = (0usize, 0usize);
-    for (k, tri) in (0..300u64)
-        .map(|k| {
-            std::array::from_fn(|v| {
-                let v = v as u64;
-                Vec3::new(
-                    r(k, 3 * v) * 2.0,
-                    r(k, 3 * v + 1) * 2.0,
-                    -2.0 + 1.8 * r(k, 3 * v + 2),
-                )
-            })
-        })
-        .chain([sliver])
-        .enumerate()
-    {
+    for (k, tri) in random_triangles(&[7]).chain([sliver]).enumerate() {
         let v = tri.map(|p| view.view_from_world.transform_point3(p));
         for s in setup::setup_triangle(v, &view) {
             let g = s.depth_gradient();
