@@ -227,6 +227,15 @@ fn clipped_projection(v: &[DVec3; 3], planes: &[(DVec3, f64); 6]) -> Option<(DVe
     let mut n = 3;
     for (normal, offset) in planes {
         let side = |p: DVec3| normal.dot(p) + offset;
+        // Most triangles lie wholly inside a plane (the clip would keep every vertex) or
+        // wholly outside (it would keep none): the same result without the copies.
+        let inside = poly[..n].iter().filter(|&&p| side(p) >= 0.0).count();
+        if inside == n {
+            continue;
+        }
+        if inside == 0 {
+            return None;
+        }
         let mut m = 0;
         for i in 0..n {
             let (a, b) = (poly[i], poly[(i + 1) % n]);
