@@ -57,7 +57,7 @@ pub struct LightDomain {
     /// whose sides follow the map's axes): its rectangles are then clipped by two comparisons.
     bounds: (DVec2, DVec2),
     is_box: bool,
-    /// The outline's vertex angles around the centre, when it is star-shaped from it with
+    /// The outline ordered by angle around the centre, when it is star-shaped from it with
     /// many vertices (a disk's 64-gon): [`LightDomain::edge`] then takes the few vertices
     /// inside an edge's wedge instead of clipping the whole outline.
     fan: Option<Fan>,
@@ -79,8 +79,10 @@ const FAN_MIN_VERTICES: usize = 8;
 struct Fan {
     /// Vertices, counter-clockwise.
     points: Vec<DVec2>,
-    /// Each vertex's [`pseudo_angle`] from vertex 0's, increasing from 0 within `0..4`.
+    /// Each vertex's [`pseudo_angle`] less vertex 0's (`start`), increasing from 0 within
+    /// `0..4`.
     turns: Vec<f64>,
+    start: f64,
 }
 
 /// A number in `0..4` that increases with the direction's angle counter-clockwise from +x
@@ -120,10 +122,11 @@ impl Fan {
             .iter()
             .map(|&p| (pseudo_angle(p) - start).rem_euclid(4.0))
             .collect();
-        turns
-            .windows(2)
-            .all(|w| w[0] < w[1])
-            .then_some(Self { points, turns })
+        turns.windows(2).all(|w| w[0] < w[1]).then_some(Self {
+            points,
+            turns,
+            start,
+        })
     }
 
     /// Where the ray from the origin along `d` leaves the outline through the edge from
@@ -139,7 +142,7 @@ impl Fan {
     fn wedge(&self, a: DVec2, b: DVec2, poly: &mut Vec<DVec2>) {
         let n = self.points.len();
         // The edge `a`'s ray leaves through: the last vertex at or before its direction.
-        let t = (pseudo_angle(a) - pseudo_angle(self.points[0])).rem_euclid(4.0);
+        let t = (pseudo_angle(a) - self.start).rem_euclid(4.0);
         let i = self.turns.partition_point(|&x| x <= t).max(1) - 1;
         poly.clear();
         poly.push(DVec2::ZERO);

@@ -514,9 +514,10 @@ impl Pieces {
 /// Scan-converts the pieces `bin` of `setups` within band `band` of rows, in order, handing
 /// each covered pixel's index within the band, triangle and depth to `put`. With `plane`, the
 /// pixels of a wide triangle's covered runs take their depth from its plane
-/// ([`setup::ScreenTriangle::depth_on_plane`]): the shadow maps, whose f32 depths it leaves
-/// as they were on every map compared (`rasterize_depth_matches_rasterize`'s scenes); the
-/// view keeps the barycentric form, which every technique's view samples come from.
+/// ([`setup::ScreenTriangle::depth_on_plane`]): the shadow maps, whose f32 depths agree with
+/// the barycentric ones to rounding (`plane_depths_equal_barycentric_depths`; equal on the
+/// layered maps of `depth_peeling_layers_are_strictly_ordered_sorted_hits`); the view keeps
+/// the barycentric form, which every technique's view samples come from.
 fn scan_band(
     setups: &Pieces,
     bin: &[u32],
