@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes shadow-core/assets/scenes/spot-lamp.gltf, the file behind the built-in scene
+"""Writes shadow-scenes/assets/scenes/spot-lamp.gltf, the file behind the built-in scene
 `spot-lamp`: a floor, a box on legs and a ball, lit by a KHR_lights_punctual spot light
 pointing down (and a camera). The scene is loaded by the glTF loader like a user's file, so
 the conformance suite covers the punctual-light path end to end.
@@ -107,6 +107,6 @@ doc = {
     "bufferViews": views,
     "accessors": accessors,
 }
-out = Path(__file__).resolve().parent.parent / "shadow-core/assets/scenes/spot-lamp.gltf"
+out = Path(__file__).resolve().parent.parent / "shadow-scenes/assets/scenes/spot-lamp.gltf"
 out.write_text(json.dumps(doc, indent=1) + "\n")
 print(f"wrote {out} ({out.stat().st_size} bytes)")

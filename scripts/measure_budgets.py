@@ -16,7 +16,7 @@ to one new scene adds it. Budgets are these numbers with the margins of `Budget:
 The measurements come from the test suite's lines on standard input, or with `--report` from
 the `report.json` of `cargo xtask conformance`.
 
-`--corpus` folds every corpus scene's row into the one `corpus` row (`shadow_core::preset::
+`--corpus` folds every corpus scene's row into the one `corpus` row (`shadow_presets::
 CORPUS_ROW`): each measure its largest over the scenes (bias: the signed value of the largest
 magnitude). `--max` keeps, measure by measure, the larger of the row already in the table and
 the new one: how a table holds the larger error of two image sizes (the GPU presets run at

@@ -4,8 +4,8 @@
 
 use glam::Vec3;
 use shadow_core::prelude::*;
-use shadow_core::scenes::quad_over_plane as q;
 use shadow_core::visibility::Coefficients;
+use shadow_scenes::quad_over_plane as q;
 
 fn overlap(a0: f64, a1: f64, b0: f64, b1: f64) -> f64 {
     (a1.min(b1) - a0.max(b0)).max(0.0)

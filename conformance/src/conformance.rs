@@ -4,10 +4,12 @@
 use std::sync::OnceLock;
 use std::time::Instant;
 
+use glam::Vec3;
 use serde::Serialize;
-use shadow_core::metrics::{Metrics, compare};
 use shadow_core::prelude::*;
-use shadow_core::preset::{Budget, Preset};
+use shadow_io::SceneSetup;
+use shadow_metrics::{Metrics, compare};
+use shadow_presets::{Budget, Preset};
 use shadow_ref::Reference;
 
 /// Mixed into the seed of the stratified reference so its samples differ from a technique's.
@@ -26,6 +28,97 @@ pub struct SuiteConfig {
     pub seed: u64,
     /// Check determinism and convergence (two and three extra runs per case).
     pub extra_checks: bool,
+    /// Where the receivers come from.
+    pub receivers: ReceiverMode,
+}
+
+/// Where a run's receivers come from: the built-in rasterizer, or the same surfaces handed in
+/// as another renderer would (`shadow_core::receivers`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ReceiverMode {
+    /// The camera's view samples.
+    #[default]
+    Camera,
+    /// The view samples as a foreign float G-buffer with the camera: positions moved along
+    /// their normals by up to `1e-6` of the scene's size (a renderer's depth precision), no
+    /// triangle ids, snapped back onto the scene.
+    Gbuffer,
+    /// The valid view samples as points with normals in a shuffled order, without a camera.
+    Points,
+}
+
+impl ReceiverMode {
+    /// The mode's name (`camera`, `gbuffer`, `points`).
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Camera => "camera",
+            Self::Gbuffer => "gbuffer",
+            Self::Points => "points",
+        }
+    }
+
+    /// Parses `camera`, `gbuffer` or `points`.
+    ///
+    /// # Errors
+    /// A message naming the valid modes.
+    pub fn parse(s: &str) -> Result<Self, String> {
+        match s {
+            "camera" => Ok(Self::Camera),
+            "gbuffer" => Ok(Self::Gbuffer),
+            "points" => Ok(Self::Points),
+            other => Err(format!(
+                "unknown receivers `{other}`; valid: camera, gbuffer, points"
+            )),
+        }
+    }
+
+    /// The receivers of `view` (rendered from `scene`'s camera) in this mode.
+    ///
+    /// # Errors
+    /// The receivers' error as text (none for a rendered view).
+    pub fn receivers(self, scene: &dyn Scene, view: ViewSamples) -> Result<ViewSamples, String> {
+        let snapping = shadow_core::receivers::Snapping::for_scene(scene);
+        let valid: Vec<usize> = (0..view.len()).filter(|&i| view.is_valid(i)).collect();
+        match self {
+            Self::Camera => Ok(view),
+            Self::Gbuffer => {
+                let scale = 1e-6 * scene.bounds().diagonal();
+                let positions: Vec<Vec3> = (0..view.len())
+                    .map(|i| {
+                        view.positions()[i] + view.geometric_normals()[i] * (scale * jitter(i))
+                    })
+                    .collect();
+                let mask = view.valid_mask();
+                let g = shadow_core::receivers::GBuffer {
+                    width: view.width(),
+                    height: view.height(),
+                    positions: &positions,
+                    geometric_normals: view.geometric_normals(),
+                    shading_normals: Some(view.shading_normals()),
+                    albedo: None,
+                    valid: Some(&mask),
+                    camera: view.raster_view().copied(),
+                };
+                ViewSamples::from_gbuffer(scene, &g, snapping).map_err(|e| e.to_string())
+            }
+            Self::Points => {
+                let mut order = valid;
+                order.sort_by_key(|&i| (i as u64).wrapping_mul(0x2545_F491_4F6C_DD1D));
+                let positions: Vec<Vec3> = order.iter().map(|&i| view.positions()[i]).collect();
+                let normals: Vec<Vec3> =
+                    order.iter().map(|&i| view.geometric_normals()[i]).collect();
+                ViewSamples::from_points(scene, &positions, &normals, snapping)
+                    .map_err(|e| e.to_string())
+            }
+        }
+    }
+}
+
+/// A reproducible value in `[-1, 1)` per index.
+fn jitter(i: usize) -> f32 {
+    let h = (i as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    (h >> 40) as f32 / (1u64 << 23) as f32 - 1.0
 }
 
 /// The image size every budget was measured at. Max error is a tail statistic that grows with
@@ -47,6 +140,7 @@ impl Default for SuiteConfig {
             ref_samples: 1024,
             seed: 1,
             extra_checks: true,
+            receivers: ReceiverMode::Camera,
         }
     }
 }
@@ -76,6 +170,7 @@ impl SceneContext {
         let camera = setup.camera_or_default();
         let view = ViewSamples::render(setup.scene.as_ref(), &camera, config.width, config.height)
             .map_err(|e| e.to_string())?;
+        let view = config.receivers.receivers(setup.scene.as_ref(), view)?;
         Ok(Self {
             setup,
             view,
@@ -344,7 +439,13 @@ pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
         }
     };
     let false_shadow = false_shadow_share(&est.visibility, &reference);
-    let budget = (preset.budget)(&ctx.setup.name);
+    // A preset may declare a budget of its own for a receiver mode (`bunny@points`): `auto`
+    // chooses among fewer candidates where there is no camera.
+    let budget = match ctx.config.receivers {
+        ReceiverMode::Camera => None,
+        mode => (preset.budget)(&format!("{}@{}", ctx.setup.name, mode.label())),
+    }
+    .or_else(|| (preset.budget)(&ctx.setup.name));
     let mut notes = Vec::new();
     if !est.decision.is_null() {
         let d = &est.decision;

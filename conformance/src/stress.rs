@@ -8,13 +8,14 @@ use std::sync::Arc;
 
 use glam::{Affine3A, Vec3};
 use serde::Serialize;
-use shadow_core::load::{LoadLimits, load_gltf_slice, load_obj_slice};
-use shadow_core::metrics::compare;
 use shadow_core::prelude::*;
-use shadow_core::preset::Preset;
-use shadow_core::procedural::{cuboid, floor, quad};
 use shadow_core::scene::SceneError;
-use shadow_core::scenes::{builtin, transformed};
+use shadow_io::SceneSetup;
+use shadow_io::load::{LoadLimits, load_gltf_slice, load_obj_slice};
+use shadow_metrics::compare;
+use shadow_presets::Preset;
+use shadow_scenes::procedural::{cuboid, floor, quad};
+use shadow_scenes::{builtin, transformed};
 
 /// Built-in rooms around their light: each technique must render them or refuse them with a
 /// reason (one light-centre shadow map cannot hold a room).
@@ -128,7 +129,7 @@ fn camera(eye: Vec3, target: Vec3) -> Camera {
 }
 
 fn q_floor() -> f32 {
-    shadow_core::scenes::quad_over_plane::FLOOR_SIDE
+    shadow_scenes::quad_over_plane::FLOOR_SIDE
 }
 
 fn mesh(m: (Vec<Vec3>, Vec<[u32; 3]>)) -> MeshDesc {
@@ -273,7 +274,7 @@ struct Compared {
 }
 
 /// Technique cases for one preset at `width x height`; each scene of `corpus` (names of the
-/// corpus of real meshes, `shadow_core::corpus`) adds a case `far-<scene>`: that scene 100
+/// corpus of real meshes, `shadow_scenes::corpus`) adds a case `far-<scene>`: that scene 100
 /// times larger and 100 km from the origin against itself where it is.
 pub fn technique_cases(
     preset: &Preset,
@@ -288,7 +289,7 @@ pub fn technique_cases(
     // other approximations), at least 0.02: an approximate technique is held to the error it
     // declares somewhere, not to its best case. Invariance under scaling and translation: 0.02
     // RMSE for every technique.
-    let tol = shadow_core::scenes::BUILTIN_SCENES
+    let tol = shadow_scenes::BUILTIN_SCENES
         .iter()
         .filter(|s| !matches!(**s, "semi-opaque" | "textured-light"))
         .filter_map(|s| (preset.budget)(s))
@@ -399,7 +400,7 @@ pub fn technique_cases(
     // Issue 51 item 5: what else the scene holds must not move the receivers' shadow rays: a
     // 200 km floor, or one far triangle, against the same occluder and light.
     let quad_scene = |floor_side: f32, far: bool| {
-        use shadow_core::scenes::quad_over_plane as q;
+        use shadow_scenes::quad_over_plane as q;
         let mut meshes = vec![
             mesh(floor(floor_side, 0.0)),
             mesh(quad(

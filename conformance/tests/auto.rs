@@ -3,11 +3,12 @@
 //! under an error budget whatever the thread count, gives the outputs asked for, picks the
 //! fastest prediction when nothing fits a time budget, and refuses bad budgets.
 
-use shadow_conformance::auto::{Auto, AutoBudget};
-use shadow_core::metrics::compare;
+use shadow_auto::{Auto, AutoBudget};
 use shadow_core::prelude::*;
-use shadow_core::scenes::builtin;
+use shadow_io::SceneSetup;
+use shadow_metrics::compare;
 use shadow_ref::Reference;
+use shadow_scenes::builtin;
 
 fn view_of(setup: &SceneSetup, w: u32, h: u32) -> ViewSamples {
     ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), w, h).unwrap()
@@ -32,7 +33,7 @@ fn auto_meets_rmse_budgets_and_says_what_it_chose() {
             Outputs::VISIBILITY,
         );
         for budget in [0.03, 0.01] {
-            let auto = Auto::new(AutoBudget::Rmse(budget), 1).unwrap();
+            let auto = Auto::new(AutoBudget::Rmse(budget), 1, shadow_presets::build).unwrap();
             let e = run(&auto, &setup, &view, Outputs::VISIBILITY);
             let rmse = compare(&e.visibility, &truth.visibility).unwrap().rmse;
             let choice = e.decision["choice"].as_str().unwrap();
@@ -52,7 +53,7 @@ fn auto_meets_rmse_budgets_and_says_what_it_chose() {
 fn auto_under_an_error_budget_is_deterministic_whatever_the_thread_count() {
     let setup = builtin("overlapping-occluders").unwrap();
     let view = view_of(&setup, 48, 36);
-    let auto = Auto::new(AutoBudget::Rmse(0.01), 7).unwrap();
+    let auto = Auto::new(AutoBudget::Rmse(0.01), 7, shadow_presets::build).unwrap();
     let one = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
@@ -67,7 +68,7 @@ fn auto_under_an_error_budget_is_deterministic_whatever_the_thread_count() {
 fn auto_gives_the_outputs_asked_for() {
     let setup = builtin("bunny").unwrap();
     let view = view_of(&setup, 32, 24);
-    let auto = Auto::new(AutoBudget::Rmse(0.03), 1).unwrap();
+    let auto = Auto::new(AutoBudget::Rmse(0.03), 1, shadow_presets::build).unwrap();
     let direct = Outputs {
         per_sample: false,
         direct: true,
@@ -81,7 +82,7 @@ fn auto_gives_the_outputs_asked_for() {
 fn nothing_fits_a_tiny_time_budget_so_auto_takes_the_fastest_prediction() {
     let setup = builtin("contact").unwrap();
     let view = view_of(&setup, 48, 36);
-    let auto = Auto::new(AutoBudget::Seconds(1e-9), 1).unwrap();
+    let auto = Auto::new(AutoBudget::Seconds(1e-9), 1, shadow_presets::build).unwrap();
     let e = run(&auto, &setup, &view, Outputs::VISIBILITY);
     let fastest = e.decision["candidates"]
         .as_array()
@@ -114,7 +115,10 @@ fn bad_budgets_are_errors() {
         AutoBudget::Seconds(f64::INFINITY),
     ] {
         assert!(
-            matches!(Auto::new(b, 1), Err(TechniqueError::InvalidInput(_))),
+            matches!(
+                Auto::new(b, 1, shadow_presets::build),
+                Err(TechniqueError::InvalidInput(_))
+            ),
             "{b:?}"
         );
     }
@@ -127,7 +131,7 @@ fn bad_budgets_are_errors() {
 /// reference on semi-opaque occluders and on `grass` (a silhouette edge for every edge).
 #[test]
 fn the_dcs_probe_measures_what_the_reference_probe_measures() {
-    use shadow_conformance::auto::{ProbeKind, measure_features, measure_features_by};
+    use shadow_auto::{ProbeKind, measure_features, measure_features_by};
     for scene in [
         "bunny",
         "quad-over-plane",
@@ -177,7 +181,7 @@ fn the_dcs_probe_measures_what_the_reference_probe_measures() {
     // DCS chosen after a DCS look runs on the look's preparation.
     let setup = builtin("bunny").unwrap();
     let view = view_of(&setup, 64, 48);
-    let auto = Auto::new(AutoBudget::Rmse(0.01), 1).unwrap();
+    let auto = Auto::new(AutoBudget::Rmse(0.01), 1, shadow_presets::build).unwrap();
     let prepared = auto
         .prepare(setup.scene.clone(), setup.lights[0].clone())
         .unwrap();

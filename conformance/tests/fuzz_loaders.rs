@@ -12,8 +12,8 @@
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::time::{Duration, Instant};
 
-use shadow_core::load::{LoadLimits, load_gltf_slice, load_obj_slice};
 use shadow_core::prelude::*;
+use shadow_io::load::{LoadLimits, load_gltf_slice, load_obj_slice};
 
 /// Cases per loader in `cargo test` (a few seconds each in the test profile).
 const BOUNDED_CASES: usize = 400;
@@ -290,7 +290,7 @@ fn glb_survives_mutation() {
     let (json, bin) = gltf_seed(false);
     fuzz(
         "glb",
-        &shadow_core::load::glb_bytes(&json, &bin),
+        &shadow_io::load::glb_bytes(&json, &bin),
         0xd1b5_4a32_d192_ed03,
     );
 }

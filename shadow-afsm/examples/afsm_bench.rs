@@ -11,8 +11,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use shadow_afsm::Afsm;
-use shadow_core::metrics::compare;
 use shadow_core::prelude::*;
+use shadow_metrics::compare;
 use shadow_ref::Reference;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -21,7 +21,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let w: u32 = args.get(2).map_or(Ok(128), |s| s.parse())?;
     let h: u32 = args.get(3).map_or(Ok(96), |s| s.parse())?;
     let n: u32 = args.get(4).map_or(Ok(128), |s| s.parse())?;
-    let setup = shadow_core::scenes::builtin(scene)?;
+    let setup = shadow_scenes::builtin(scene)?;
     let light = Arc::clone(&setup.lights[0]);
     let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), w, h)?;
     let mode = args.get(5).map_or("exact", String::as_str);

@@ -33,7 +33,7 @@
 //! use shadow_afsm::Afsm;
 //! use shadow_core::prelude::*;
 //!
-//! let setup = shadow_core::scenes::builtin("quad-over-plane").unwrap();
+//! let setup = shadow_scenes::builtin("quad-over-plane").unwrap();
 //! let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 24, 18).unwrap();
 //! let afsm = Afsm::new(32, SamplingStrategy::Correlated, 1).unwrap();
 //! match afsm.prepare(setup.scene.clone(), setup.lights[0].clone()) {
@@ -51,7 +51,6 @@
 
 #![deny(missing_docs)]
 
-pub mod budgets;
 pub mod frame;
 pub mod influence;
 mod inputs;
@@ -59,12 +58,10 @@ pub mod lut;
 pub mod params;
 pub mod passes;
 pub mod pipelines;
-mod presets;
 pub mod sample_grid;
 pub mod technique;
 pub mod temporal;
 pub mod volume;
 
-pub use presets::presets;
 pub use technique::{Afsm, PlaneTest, PreparedAfsm};
 pub use temporal::{TemporalAccumulator, accumulate};

@@ -764,28 +764,45 @@ impl PreparedShadows for PreparedAfsm {
         &self.stats
     }
 
-    fn estimate(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError> {
-        let (mut est, _, _) = self.run(view, false)?;
-        if outputs.direct {
-            let sampler = self.config.light_sampler().ok_or_else(|| {
-                TechniqueError::unsupported(
-                    &self.config.name,
-                    UnsupportedReason::Configuration(
-                        "hard shadows have no light samples to shade direct light from".into(),
-                    ),
-                )
-            })?;
-            let t0 = std::time::Instant::now();
-            est.direct = Some(shadow_core::technique::direct_from_per_sample(
-                self.p.scene.as_ref(),
-                self.p.light.as_ref(),
-                sampler,
-                view,
-                &est.visibility,
-            )?);
-            est.stats.add_time("direct", t0.elapsed().as_secs_f64());
+    fn light(&self) -> &dyn AreaLight {
+        self.p.light.as_ref()
+    }
+
+    fn check_outputs(&self, outputs: Outputs) -> Result<(), TechniqueError> {
+        if outputs.direct && self.config.light_sampler().is_none() {
+            return Err(TechniqueError::unsupported(
+                &self.config.name,
+                UnsupportedReason::Configuration(
+                    "hard shadows have no light samples to shade direct light from".into(),
+                ),
+            ));
         }
-        est.darken_behind_light(view, self.p.light.as_ref());
-        Ok(est)
+        Ok(())
+    }
+
+    fn pass(&self, view: &ViewSamples, _outputs: Outputs) -> Result<Estimate, TechniqueError> {
+        self.run(view, false).map(|(est, _, _)| est)
+    }
+
+    fn direct_light(
+        &self,
+        view: &ViewSamples,
+        est: &Estimate,
+    ) -> Result<Vec<Vec3>, TechniqueError> {
+        let sampler = self.config.light_sampler().ok_or_else(|| {
+            TechniqueError::unsupported(
+                &self.config.name,
+                UnsupportedReason::Configuration(
+                    "hard shadows have no light samples to shade direct light from".into(),
+                ),
+            )
+        })?;
+        shadow_core::technique::direct_from_per_sample(
+            self.p.scene.as_ref(),
+            self.p.light.as_ref(),
+            sampler,
+            view,
+            &est.visibility,
+        )
     }
 }

@@ -7,10 +7,11 @@ use std::sync::Arc;
 
 use shadow_afsm::Afsm;
 use shadow_core::gpu::context_for_test;
-use shadow_core::metrics::compare;
 use shadow_core::prelude::*;
-use shadow_core::scenes::{BUILTIN_SCENES, builtin};
+use shadow_io::SceneSetup;
+use shadow_metrics::compare;
 use shadow_ref::Reference;
+use shadow_scenes::{BUILTIN_SCENES, builtin};
 
 fn view_of(setup: &SceneSetup, w: u32, h: u32) -> ViewSamples {
     ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), w, h).unwrap()

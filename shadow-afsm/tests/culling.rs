@@ -13,9 +13,9 @@ use std::sync::Arc;
 
 use shadow_afsm::Afsm;
 use shadow_core::gpu::context_for_test;
-use shadow_core::metrics::compare;
 use shadow_core::prelude::*;
-use shadow_core::scenes::builtin;
+use shadow_metrics::compare;
+use shadow_scenes::builtin;
 
 #[test]
 fn cluster_culling_changes_no_bit_and_tests_fewer_pairs() {

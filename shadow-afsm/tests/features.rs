@@ -6,10 +6,11 @@ use std::sync::Arc;
 use glam::Vec3;
 use shadow_afsm::{Afsm, accumulate};
 use shadow_core::gpu::context_for_test;
-use shadow_core::metrics::compare;
 use shadow_core::prelude::*;
-use shadow_core::scenes::builtin;
+use shadow_io::SceneSetup;
+use shadow_metrics::compare;
 use shadow_ref::Reference;
+use shadow_scenes::builtin;
 
 fn setup_view(name: &str, w: u32, h: u32) -> (SceneSetup, ViewSamples) {
     let setup = builtin(name).unwrap();
@@ -36,7 +37,7 @@ fn square_light(side: f32, height: f32) -> Light {
 fn floor_scene(meshes: Vec<MeshDesc>, w: u32, h: u32) -> (SceneRef, ViewSamples) {
     use glam::Vec3;
     let mut b = SceneBuilder::new();
-    let f = shadow_core::procedural::floor(8.0, 0.0);
+    let f = shadow_scenes::procedural::floor(8.0, 0.0);
     b.push_mesh(MeshDesc::new(f.0, f.1)).unwrap();
     for m in meshes {
         b.push_mesh(m).unwrap();
@@ -188,7 +189,7 @@ fn silhouette_stencil_changes_no_bit_and_skips_umbra_work() {
     if context_for_test("silhouette_stencil_changes_no_bit_and_skips_umbra_work").is_none() {
         return;
     }
-    let s = shadow_core::procedural::uv_sphere(glam::Vec3::new(0.0, 1.2, 0.0), 0.7, 24, 48);
+    let s = shadow_scenes::procedural::uv_sphere(glam::Vec3::new(0.0, 1.2, 0.0), 0.7, 24, 48);
     let (scene, view) = floor_scene(vec![MeshDesc::new(s.0, s.1)], 48, 36);
     let light = square_light(0.3, 4.0);
     assert!(scene.topology().components().iter().any(|c| c.closed));
@@ -280,7 +281,7 @@ fn optical_depth_sums_saturate_instead_of_wrapping() {
     let opacity = 1.0 - 18.0 / 16_777_216.0;
     let panels = (0..298)
         .map(|k| {
-            let q = shadow_core::procedural::quad(
+            let q = shadow_scenes::procedural::quad(
                 glam::Vec3::new(0.0, 1.0 + k as f32 * 0.002, 0.0),
                 glam::Vec3::X * 0.6,
                 glam::Vec3::Z * 0.6,
@@ -317,7 +318,7 @@ fn polygon_light_agrees_with_the_same_samples_reference() {
         return;
     }
     use glam::Vec3;
-    let s = shadow_core::procedural::uv_sphere(Vec3::new(0.2, 1.0, 0.0), 0.5, 12, 24);
+    let s = shadow_scenes::procedural::uv_sphere(Vec3::new(0.2, 1.0, 0.0), 0.5, 12, 24);
     let (scene, view) = floor_scene(vec![MeshDesc::new(s.0, s.1)], 48, 36);
     let outline: Vec<Vec3> = (0..6)
         .map(|k| {
@@ -356,9 +357,9 @@ fn receivers_inside_a_closed_mesh_are_shadowed() {
         return;
     }
     let mut b = SceneBuilder::new();
-    let f = shadow_core::procedural::floor(1.6, 0.05);
+    let f = shadow_scenes::procedural::floor(1.6, 0.05);
     b.push_mesh(MeshDesc::new(f.0, f.1)).unwrap();
-    let shell = shadow_core::procedural::cuboid(
+    let shell = shadow_scenes::procedural::cuboid(
         Vec3::new(-1.0, 0.0, -1.0),
         Vec3::new(1.0, 2.0, 1.0),
         false,

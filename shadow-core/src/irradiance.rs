@@ -347,6 +347,7 @@ mod tests {
             shading_normal: n_s,
             triangle: 0,
             depth: 1.0,
+            albedo: None,
         }
     }
 

@@ -12,13 +12,18 @@
 //!   G-buffers now, shadow maps and depth peeling for the SSM family) and the shared view samples.
 //! * [`visibility`] and [`technique`]: visibility buffers and the object-safe
 //!   [`ShadowTechnique`] trait with its [`Stats`] and [`TechniqueError`].
-//! * [`direct`]: direct illumination from per-sample visibility (DCS eq. 6).
-//! * [`metrics`]: RMSE, penumbra RMSE, bias, max error, share over 0.1, per-sample agreement.
-//! * [`preset`]: named technique configurations with their error budgets.
-//! * [`load`], [`scenes`] and [`procedural`]: glTF and OBJ loading, built-in scenes.
-//! * [`image_io`]: EXR and PNG output.
+//! * [`direct`] and [`irradiance`]: direct illumination from per-sample visibility (DCS eq. 6)
+//!   and the closed-form unshadowed irradiance of planar lights.
+//! * [`receivers`]: receivers handed in by the caller (a renderer's G-buffer, or points with
+//!   normals), snapped onto the scene.
+//! * [`rays`]: the shadow-ray traits a hybrid technique takes its rays through, so that no
+//!   technique crate depends on the reference.
 //! * `gpu` (feature `gpu`): wgpu device creation with a software fallback, upload, readback
 //!   and naga validation of WGSL, for GPU techniques.
+//!
+//! What is not here lives in crates named for it: loading and image output (`shadow-io`), the
+//! built-in scenes and the corpus (`shadow-scenes`), error metrics (`shadow-metrics`), presets
+//! and their budgets (`shadow-presets`).
 //!
 //! The visibility coefficient is `V(p) = (1/|L|) * integral of v(p, y) dA(y)` over the light
 //! (DCS eq. 1): the unweighted fraction of the light's area visible from `p`, where `y` below
@@ -26,15 +31,24 @@
 //! from its front side only) gets none of it.
 //!
 //! ```
+//! use glam::{UVec2, Vec3};
 //! use shadow_core::prelude::*;
 //!
-//! let setup = shadow_core::scenes::builtin("quad-over-plane").unwrap();
-//! let camera = setup.camera_or_default();
-//! let view = ViewSamples::render(setup.scene.as_ref(), &camera, 32, 24).unwrap();
+//! // A floor under a square light facing down, seen from above.
+//! let floor = MeshDesc::new(
+//!     vec![Vec3::new(-2.0, 0.0, -2.0), Vec3::new(2.0, 0.0, -2.0), Vec3::new(2.0, 0.0, 2.0), Vec3::new(-2.0, 0.0, 2.0)],
+//!     vec![[0, 2, 1], [0, 3, 2]],
+//! );
+//! let mut builder = SceneBuilder::new();
+//! builder.push_mesh(floor).unwrap();
+//! let scene = builder.build().unwrap();
+//! let light = RectLight::new(Vec3::Y * 2.0, Vec3::X * 0.5, Vec3::Z * 0.5, Radiance::Constant(Vec3::ONE)).unwrap();
+//! let camera = Camera::look_at(Vec3::new(0.0, 3.0, 3.0), Vec3::ZERO, Vec3::Y, 0.9).unwrap();
+//! let view = ViewSamples::render(&scene, &camera, 32, 24).unwrap();
 //! assert!(view.valid_count() > 0);
 //! let sampler = LightSampler::new(SamplingStrategy::Stratified, 16, 7).unwrap();
 //! let mut samples = Vec::new();
-//! sampler.light_samples(setup.lights[0].as_ref(), glam::UVec2::new(3, 4), &mut samples);
+//! sampler.light_samples(&light, UVec2::new(3, 4), &mut samples);
 //! assert_eq!(samples.len(), 16);
 //! ```
 
@@ -42,26 +56,21 @@
 
 pub mod albedo;
 pub mod camera;
-pub mod corpus;
 pub mod direct;
 pub mod geometry;
 #[cfg(feature = "gpu")]
 pub mod gpu;
 #[cfg(feature = "gpu")]
 mod gpu_timestamps;
-pub mod image_io;
 pub mod irradiance;
 pub mod light;
-pub mod load;
-pub mod metrics;
 pub mod offset;
-pub mod preset;
-pub mod procedural;
 pub mod raster;
+pub mod rays;
+pub mod receivers;
 mod rounding;
 pub mod sampling;
 pub mod scene;
-pub mod scenes;
 pub mod technique;
 pub mod topology;
 pub mod triangulate;
@@ -84,9 +93,6 @@ pub mod prelude {
         AreaLight, DiskLight, Light, LightKind, LightSample, PointLight, PolygonLight, Radiance,
         RectLight, SphereLight,
     };
-    pub use crate::load::SceneSetup;
-    pub use crate::metrics::{Metrics, compare};
-    pub use crate::preset::{Budget, Preset};
     pub use crate::sampling::{LightSampler, SamplingStrategy};
     pub use crate::scene::{MeshDesc, Scene, SceneBuilder, TriangleScene};
     pub use crate::technique::{

@@ -144,6 +144,9 @@ pub struct Capabilities {
     pub sample_based: bool,
     /// CPU or GPU.
     pub processor: Processor,
+    /// Works in the camera's image (DCS's shadow volumes counted from the eye, GBP07's
+    /// screen-space selection): receivers without a perspective camera are refused.
+    pub needs_camera: bool,
 }
 
 impl Capabilities {
@@ -158,7 +161,23 @@ impl Capabilities {
             needs_closed_meshes: false,
             sample_based,
             processor,
+            needs_camera: false,
         }
+    }
+
+    /// `Ok` when the technique takes `view`'s receivers, else the reason (receivers without a
+    /// perspective camera for a technique that [`Capabilities::needs_camera`]).
+    ///
+    /// # Errors
+    /// [`UnsupportedReason::View`].
+    pub fn check_view(&self, view: &ViewSamples) -> Result<(), UnsupportedReason> {
+        if self.needs_camera && view.eye().is_none() {
+            return Err(UnsupportedReason::View(
+                "the technique works in a perspective camera's image; these receivers have none"
+                    .into(),
+            ));
+        }
+        Ok(())
     }
 
     /// `Ok` when the technique can handle `scene` lit by `light`, else the reason.
@@ -367,8 +386,8 @@ impl Estimate {
     /// Applies the light-side rule every technique shares: a receiver behind the plane a
     /// planar light emits from (or in it) gets no light, so its visibility, per-sample
     /// visibility and direct light are zero ([`crate::light::LightGeometry::behind`]). Counts
-    /// the pixels in `pixels-behind-light`. Techniques call it last in their estimate, after
-    /// skipping those pixels' work where they can.
+    /// the pixels in `pixels-behind-light`. [`finish_estimate`] applies it after every
+    /// technique's pass; techniques skip those pixels' work where they can.
     pub fn darken_behind_light(&mut self, view: &ViewSamples, light: &dyn AreaLight) {
         let geometry = light.geometry();
         if geometry.emitting_plane().is_none() {
@@ -427,16 +446,86 @@ pub trait ShadowTechnique: Send + Sync {
 }
 
 /// A technique prepared for one scene and light.
+///
+/// A technique implements its own pass ([`PreparedShadows::pass`]) and, when it can shade,
+/// [`PreparedShadows::direct_light`]; the steps every technique shares are
+/// [`PreparedShadows::estimate`]'s, written once here ([`finish_estimate`]): outputs refused
+/// before any work, direct light timed as the `direct` phase, the behind-the-light rule,
+/// validation.
 pub trait PreparedShadows: Send + Sync + std::fmt::Debug {
     /// The technique's name.
     fn name(&self) -> &str;
     /// Times and counters of the preparation.
     fn preparation(&self) -> &Stats;
-    /// Computes the visibility of every view sample, and what `outputs` asks for besides.
+    /// The light it was prepared for.
+    fn light(&self) -> &dyn AreaLight;
+    /// Refuses, before any work, `outputs` the technique cannot give (for example direct
+    /// light from a technique without light samples).
+    ///
+    /// # Errors
+    /// [`TechniqueError::Unsupported`] naming what cannot be given.
+    fn check_outputs(&self, outputs: Outputs) -> Result<(), TechniqueError> {
+        let _ = outputs;
+        Ok(())
+    }
+    /// The technique's own pass: the visibility of every view sample (with per-sample
+    /// visibility when `outputs.per_sample`), and direct light only where the pass computes it
+    /// itself; [`PreparedShadows::estimate`] does the rest.
     ///
     /// # Errors
     /// As the technique documents (unsupported views, device failures).
-    fn estimate(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError>;
+    fn pass(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError>;
+    /// Direct illumination (DCS eq. 6) of every view sample, from the pass's estimate; asked
+    /// for when `outputs.direct` and the pass left [`Estimate::direct`] empty.
+    ///
+    /// # Errors
+    /// [`TechniqueError::Unsupported`] by default: the technique has no light samples to shade
+    /// from.
+    fn direct_light(
+        &self,
+        view: &ViewSamples,
+        estimate: &Estimate,
+    ) -> Result<Vec<Vec3>, TechniqueError> {
+        let _ = (view, estimate);
+        Err(TechniqueError::unsupported(
+            self.name(),
+            UnsupportedReason::Configuration("the technique gives no direct light".into()),
+        ))
+    }
+    /// Computes the visibility of every view sample, and what `outputs` asks for besides: the
+    /// technique's pass, then the shared steps ([`finish_estimate`]).
+    ///
+    /// # Errors
+    /// As [`PreparedShadows::check_outputs`], [`PreparedShadows::pass`] and
+    /// [`PreparedShadows::direct_light`]; a buffer that fails validation.
+    fn estimate(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError> {
+        self.check_outputs(outputs)?;
+        let est = self.pass(view, outputs)?;
+        finish_estimate(self, view, outputs, est)
+    }
+}
+
+/// The steps every technique's estimate shares, after its pass: direct light when asked for
+/// and not given by the pass (timed as the `direct` phase), the light-side rule
+/// ([`Estimate::darken_behind_light`]), and validation of the buffer.
+///
+/// # Errors
+/// As [`PreparedShadows::direct_light`]; a buffer that fails validation.
+pub fn finish_estimate<P: PreparedShadows + ?Sized>(
+    prepared: &P,
+    view: &ViewSamples,
+    outputs: Outputs,
+    mut est: Estimate,
+) -> Result<Estimate, TechniqueError> {
+    if outputs.direct && est.direct.is_none() {
+        let t0 = std::time::Instant::now();
+        let direct = prepared.direct_light(view, &est)?;
+        est.direct = Some(direct);
+        est.stats.add_time("direct", t0.elapsed().as_secs_f64());
+    }
+    est.darken_behind_light(view, prepared.light());
+    est.visibility.validate()?;
+    Ok(est)
 }
 
 /// Direct illumination of every view sample (DCS eq. 6) from a sample-based technique's
@@ -531,7 +620,7 @@ fn shade_from_per_sample(
                 sampler.unit_samples(s.pixel, &mut units);
                 samples.clear();
                 light.sample_into(&units, &mut samples);
-                let albedo = scene.albedo_at(s.triangle as usize, s.position);
+                let albedo = s.albedo_in(scene);
                 let v = |k: usize| if per.visible(i, k as u32) { 1.0 } else { 0.0 };
                 *px = shade(&s, albedo, &samples, &v);
             }

@@ -5,6 +5,9 @@
 //! The rasterizer decides which triangle a pixel sees; the position is then the exact
 //! intersection of the pixel's camera ray with that triangle's plane (computed in f64), so it
 //! equals a ray tracer's hit point rather than an interpolated approximation.
+//!
+//! Receivers may also come from the caller ([`crate::receivers`]): a renderer's G-buffer, with
+//! its camera when it has one, or bare points with normals, snapped onto the scene.
 
 use glam::{DVec3, UVec2, Vec3};
 use rayon::prelude::*;
@@ -17,18 +20,27 @@ use crate::scene::Scene;
 /// here), a technique's outputs more (per-sample visibility: `N / 8` bytes a pixel), so a larger
 /// request is refused before anything is allocated rather than exhausting memory.
 pub const MAX_VIEW_PIXELS: u64 = 1 << 25;
-/// The G-buffer of one camera view.
+/// Marks a receiver that matched no surface of the scene within the caller's tolerance
+/// ([`crate::receivers`]): it lies on no triangle, so no triangle is its own.
+pub const FREE_RECEIVER: u32 = NO_TRIANGLE - 1;
+
+/// The receivers whose visibility is wanted: the G-buffer of one camera view, a caller's
+/// G-buffer, or a caller's points (one row, no camera).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ViewSamples {
-    width: u32,
-    height: u32,
-    camera_position: Vec3,
-    view: RasterView,
-    position: Vec<Vec3>,
-    geometric_normal: Vec<Vec3>,
-    shading_normal: Vec<Vec3>,
-    triangle: Vec<u32>,
-    depth: Vec<f32>,
+    pub(crate) width: u32,
+    pub(crate) height: u32,
+    pub(crate) camera_position: Vec3,
+    pub(crate) view: Option<RasterView>,
+    pub(crate) position: Vec<Vec3>,
+    pub(crate) geometric_normal: Vec<Vec3>,
+    pub(crate) shading_normal: Vec<Vec3>,
+    pub(crate) triangle: Vec<u32>,
+    pub(crate) depth: Vec<f32>,
+    /// The caller's albedo per receiver, when it handed one in.
+    pub(crate) albedo: Option<Vec<Vec3>>,
+    /// Receivers that matched no surface and were offset by the caller's tolerance.
+    pub(crate) unmatched: u64,
 }
 
 /// One valid view sample.
@@ -42,10 +54,26 @@ pub struct ViewSample {
     pub geometric_normal: Vec3,
     /// Unit shading normal (interpolated, on the camera's side like the geometric normal).
     pub shading_normal: Vec3,
-    /// Triangle id.
+    /// Triangle id ([`FREE_RECEIVER`] for a caller's point that matched no surface).
     pub triangle: u32,
-    /// Linear depth along the camera axis.
+    /// Linear depth along the camera axis (0 without a camera).
     pub depth: f32,
+    /// The caller's albedo, when it handed one in.
+    pub albedo: Option<Vec3>,
+}
+
+impl ViewSample {
+    /// The diffuse albedo shading uses: the caller's, else the scene's at the receiver's
+    /// triangle, else white for a receiver on no triangle.
+    pub fn albedo_in(&self, scene: &dyn Scene) -> Vec3 {
+        match self.albedo {
+            Some(a) => a,
+            None if (self.triangle as usize) < scene.triangle_count() => {
+                scene.albedo_at(self.triangle as usize, self.position)
+            }
+            None => Vec3::ONE,
+        }
+    }
 }
 
 impl ViewSamples {
@@ -117,36 +145,9 @@ impl ViewSamples {
                     *tri = NO_TRIANGLE;
                     return;
                 }
-                // The rasterizer's coverage test admits pixel centres within rounding of an
-                // edge, whose ray meets the plane just outside the triangle: a floor point a
-                // ULP beyond the foot of a wall lies behind that wall, and every technique drew
-                // a line of false shadow along room corners. The closest point of the
-                // triangle, moved a hair (2^-20 of the way) toward its centroid, puts it back
-                // on the surface the pixel sees and strictly in front of the neighbour.
-                // A hit on an edge (up to rounding) is moved the same way: a floor point
-                // exactly at the foot of a wall starts its shadow rays in the wall's plane.
-                const HAIR: f64 = 1.0 / 1_048_576.0;
-                let on = closest_on_triangle(a64, b64, c64, hit);
-                let hit = if barycentric(a64, b64, c64, n64, on).min_element() < HAIR {
-                    on + ((a64 + b64 + c64) / 3.0 - on) * HAIR
-                } else {
-                    on
-                };
-                let geo = n64.normalize();
-                let flip = geo.dot(d64) > 0.0;
-                let geo = if flip { -geo } else { geo };
-                let shading = match normals {
-                    Some(ns) => {
-                        let [ia, ib, ic] = scene.triangles()[t];
-                        let bary = barycentric(a64, b64, c64, n64, hit);
-                        let s = ns[ia as usize].as_dvec3() * bary.x
-                            + ns[ib as usize].as_dvec3() * bary.y
-                            + ns[ic as usize].as_dvec3() * bary.z;
-                        let s = s.try_normalize().unwrap_or(geo);
-                        if flip { -s } else { s }
-                    }
-                    None => geo,
-                };
+                let hit = on_surface(a64, b64, c64, n64, hit);
+                let flip = n64.dot(d64) > 0.0;
+                let (geo, shading) = surface_normals(scene, normals, t, [a64, b64, c64], hit, flip);
                 *pos = hit.as_vec3();
                 *gn = geo.as_vec3();
                 *sn = shading.as_vec3();
@@ -156,12 +157,14 @@ impl ViewSamples {
             width: w,
             height: h,
             camera_position,
-            view: *view,
+            view: Some(*view),
             position,
             geometric_normal,
             shading_normal,
             triangle,
             depth,
+            albedo: None,
+            unmatched: 0,
         })
     }
 
@@ -171,8 +174,11 @@ impl ViewSamples {
     /// look at the scene costs a copy, not a second view.
     pub fn every_kth(&self, k: u32) -> Self {
         let k = k.max(1);
-        let view = self.view.every_kth(k);
-        let (w, h) = (view.width, view.height);
+        let view = self.view.map(|v| v.every_kth(k));
+        let (w, h) = match &view {
+            Some(v) => (v.width, v.height),
+            None => (self.width.div_ceil(k), self.height.div_ceil(k)),
+        };
         let n = (w * h) as usize;
         let source = |i: usize| {
             let (x, y) = (i as u32 % w, i as u32 / w);
@@ -190,6 +196,13 @@ impl ViewSamples {
             shading_normal: (0..n).map(|i| self.shading_normal[source(i)]).collect(),
             triangle: (0..n).map(|i| self.triangle[source(i)]).collect(),
             depth: (0..n).map(|i| self.depth[source(i)]).collect(),
+            albedo: self
+                .albedo
+                .as_ref()
+                .map(|a| (0..n).map(|i| a[source(i)]).collect()),
+            unmatched: (0..n)
+                .filter(|&i| self.triangle[source(i)] == FREE_RECEIVER)
+                .count() as u64,
         }
     }
 
@@ -209,22 +222,31 @@ impl ViewSamples {
     pub fn is_empty(&self) -> bool {
         self.triangle.is_empty()
     }
-    /// Position of the camera (ray origin of perspective views).
+    /// Position of the camera (ray origin of perspective views; the origin without a camera).
     pub fn camera_position(&self) -> Vec3 {
         self.camera_position
     }
-    /// The camera projection the samples were rendered with (techniques that rasterize in the
-    /// camera's image, such as DCS's shadow-volume and wedge passes, need it).
-    pub fn raster_view(&self) -> &RasterView {
-        &self.view
+    /// The camera projection the samples were rendered with, `None` for receivers handed in
+    /// without a camera (techniques that rasterize in the camera's image, such as DCS's
+    /// shadow-volume and wedge passes, need it).
+    pub fn raster_view(&self) -> Option<&RasterView> {
+        self.view.as_ref()
     }
-    /// The eye point of a perspective view, `None` for an orthographic one.
+    /// The eye point of a perspective view and the view, `None` for an orthographic one or no
+    /// camera.
+    pub fn perspective(&self) -> Option<(Vec3, &RasterView)> {
+        self.eye().zip(self.view.as_ref())
+    }
+    /// The eye point of a perspective view, `None` for an orthographic one or no camera.
     pub fn eye(&self) -> Option<Vec3> {
-        matches!(
-            self.view.projection,
-            crate::raster::Projection::Perspective { .. }
-        )
-        .then_some(self.camera_position)
+        self.view
+            .filter(|v| matches!(v.projection, crate::raster::Projection::Perspective { .. }))
+            .map(|_| self.camera_position)
+    }
+    /// Receivers handed in by the caller that matched no surface within its tolerance and
+    /// were offset by it ([`crate::receivers`]).
+    pub fn unmatched_receivers(&self) -> u64 {
+        self.unmatched
     }
     /// True when pixel `i` (row-major) sees a surface.
     pub fn is_valid(&self, i: usize) -> bool {
@@ -267,6 +289,7 @@ impl ViewSamples {
             shading_normal: self.shading_normal[i],
             triangle: self.triangle[i],
             depth: self.depth[i],
+            albedo: self.albedo.as_ref().map(|a| a[i]),
         })
     }
     /// Positions, row-major (zero for background).
@@ -291,7 +314,54 @@ impl ViewSamples {
     }
 }
 
-/// Barycentric coordinates of `p` (on the plane of `a, b, c` with normal `n`).
+/// The surface point of triangle `a, b, c` (normal `n`, not unit) for a hit `hit` on its
+/// plane. The rasterizer's coverage test admits pixel centres within rounding of an edge,
+/// whose ray meets the plane just outside the triangle: a floor point a ULP beyond the foot of
+/// a wall lies behind that wall, and every technique drew a line of false shadow along room
+/// corners. The closest point of the triangle, moved a hair (2^-20 of the way) toward its
+/// centroid, puts it back on the surface the pixel sees and strictly in front of the
+/// neighbour. A hit on an edge (up to rounding) is moved the same way: a floor point exactly
+/// at the foot of a wall starts its shadow rays in the wall's plane.
+pub(crate) fn on_surface(a: DVec3, b: DVec3, c: DVec3, n: DVec3, hit: DVec3) -> DVec3 {
+    const HAIR: f64 = 1.0 / 1_048_576.0;
+    let on = closest_on_triangle(a, b, c, hit);
+    if barycentric(a, b, c, n, on).min_element() < HAIR {
+        on + ((a + b + c) / 3.0 - on) * HAIR
+    } else {
+        on
+    }
+}
+
+/// The unit geometric and shading normals of triangle `t` (corners `abc`) at `hit`, both
+/// flipped when `flip` (to face the viewer or the caller's normal); the shading normal is
+/// interpolated from the scene's vertex normals where it has them.
+pub(crate) fn surface_normals(
+    scene: &dyn Scene,
+    normals: Option<&[Vec3]>,
+    t: usize,
+    [a, b, c]: [DVec3; 3],
+    hit: DVec3,
+    flip: bool,
+) -> (DVec3, DVec3) {
+    let n = (b - a).cross(c - a);
+    let unflipped = n.normalize();
+    let geo = if flip { -unflipped } else { unflipped };
+    let shading = match normals {
+        Some(ns) => {
+            let [ia, ib, ic] = scene.triangles()[t];
+            let bary = barycentric(a, b, c, n, hit);
+            let s = ns[ia as usize].as_dvec3() * bary.x
+                + ns[ib as usize].as_dvec3() * bary.y
+                + ns[ic as usize].as_dvec3() * bary.z;
+            // Vertex normals that cancel fall back to the face's own normal.
+            let s = s.try_normalize().unwrap_or(unflipped);
+            if flip { -s } else { s }
+        }
+        None => geo,
+    };
+    (geo, shading)
+}
+
 /// The point of triangle `abc` closest to `p` (Ericson, "Real-Time Collision Detection",
 /// section 5.1.5), `p` itself when it lies over the triangle.
 fn closest_on_triangle(a: DVec3, b: DVec3, c: DVec3, p: DVec3) -> DVec3 {
@@ -326,6 +396,7 @@ fn closest_on_triangle(a: DVec3, b: DVec3, c: DVec3, p: DVec3) -> DVec3 {
     p
 }
 
+/// Barycentric coordinates of `p` (on the plane of `a, b, c` with normal `n`).
 fn barycentric(a: DVec3, b: DVec3, c: DVec3, n: DVec3, p: DVec3) -> DVec3 {
     let nn = n.length_squared();
     let wa = (c - b).cross(p - b).dot(n) / nn;

@@ -47,7 +47,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let (td, ed) = best(prepared_dcs.as_ref())?;
     let (tr, er) = best(r.as_ref())?;
-    let m = shadow_core::metrics::compare(&ed.visibility, &er.visibility)?;
+    let m = shadow_metrics::compare(&ed.visibility, &er.visibility)?;
     for p in &ed.stats.phases {
         print!("{} {:.4}s  ", p.name, p.seconds);
     }

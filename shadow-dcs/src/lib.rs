@@ -33,8 +33,8 @@
 //!   wedge scan tests a wedge's planes and weights for the whole tile at once;
 //! * `accel::shared_sets`: light-sample sets shared between pixels (interleaved sampling).
 //!
-//! [`technique`] is the [`Dcs`] technique that runs both; [`presets`] registers its
-//! configurations; [`paper`] is the same algorithm as the paper writes it (Algorithm 1 in f64
+//! [`technique`] is the [`Dcs`] technique that runs both (its configurations are named in
+//! `shadow-presets`); [`paper`] is the same algorithm as the paper writes it (Algorithm 1 in f64
 //! and plain integers, no search structure, no tables), the oracle the technique is tested
 //! against sample by sample (`tests/paper.rs`).
 //!
@@ -66,7 +66,7 @@
 //! use shadow_core::prelude::*;
 //! use shadow_dcs::Dcs;
 //!
-//! let setup = shadow_core::scenes::builtin("quad-over-plane").unwrap();
+//! let setup = shadow_scenes::builtin("quad-over-plane").unwrap();
 //! let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 32, 24).unwrap();
 //! let dcs = Dcs::new(16, SamplingStrategy::Stratified, 1).unwrap();
 //! let prepared = dcs.prepare(setup.scene.clone(), setup.lights[0].clone()).unwrap();
@@ -77,13 +77,10 @@
 #![deny(missing_docs)]
 
 mod accel;
-mod budgets;
 pub mod paper;
-mod presets;
 pub mod stages;
 pub mod technique;
 
-pub use presets::presets;
 pub use stages::discrete::{self, CoveredSamples};
 pub use stages::edges::{self, Silhouettes};
 pub use technique::{Dcs, PerSampleOutput, PreparedDcs, RayChoice};

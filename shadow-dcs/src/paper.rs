@@ -102,8 +102,11 @@ pub fn paper_depth_complexity(
     view: &ViewSamples,
 ) -> Result<PaperDepthComplexity, TechniqueError> {
     const NAME: &str = "dcs-paper";
-    let eye = view.eye().ok_or_else(|| {
-        TechniqueError::unsupported(NAME, UnsupportedReason::View("orthographic views".into()))
+    let (eye, camera) = view.perspective().ok_or_else(|| {
+        TechniqueError::unsupported(
+            NAME,
+            UnsupportedReason::View("orthographic views and receivers without a camera".into()),
+        )
     })?;
     let shape = LightShape::new(light, NAME)?;
     let c = shape.center;
@@ -129,15 +132,7 @@ pub fn paper_depth_complexity(
     // Section 4.1: the integration constant from the shadow-volume step.
     let eye_c = eye_constant(scene, units, eye, c);
     let (constants, _) = integration_constants(
-        &edges,
-        &sil,
-        c,
-        eye,
-        eye_c,
-        view.raster_view(),
-        &origins,
-        &centred,
-        &valid,
+        &edges, &sil, c, eye, eye_c, camera, &origins, &centred, &valid,
     );
     // Algorithm 1, per wedge: the wedge's bounding half-spaces.
     let wedges: Vec<(&SceneEdge, Vec<Plane>)> = sil

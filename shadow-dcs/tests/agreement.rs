@@ -6,6 +6,8 @@ use glam::{DVec3, Vec3};
 use shadow_core::prelude::*;
 use shadow_core::visibility::PerSampleVisibility;
 use shadow_dcs::{CoveredSamples, Dcs, PerSampleOutput, Silhouettes};
+use shadow_io::SceneSetup;
+use shadow_metrics::compare;
 use shadow_ref::Reference;
 
 fn view_of(setup: &SceneSetup, w: u32, h: u32) -> ViewSamples {
@@ -35,7 +37,7 @@ fn same_samples_reference(dcs: &Dcs) -> Reference {
 #[test]
 fn direct_illumination_equals_the_reference_with_the_same_samples() {
     for scene in ["bunny", "textured-light", "sphere-light"] {
-        let setup = shadow_core::scenes::builtin(scene).unwrap();
+        let setup = shadow_scenes::builtin(scene).unwrap();
         let view = view_of(&setup, 48, 36);
         let dcs = Dcs::new(32, SamplingStrategy::Stratified, 3).unwrap();
         let r = same_samples_reference(&dcs);
@@ -47,7 +49,7 @@ fn direct_illumination_equals_the_reference_with_the_same_samples() {
             run_with(&dcs, &setup, &view, direct),
             run_with(&r, &setup, &view, direct),
         );
-        let agreement = shadow_core::metrics::compare(&d.visibility, &e.visibility)
+        let agreement = shadow_metrics::compare(&d.visibility, &e.visibility)
             .unwrap()
             .sample_agreement
             .unwrap();
@@ -66,7 +68,7 @@ fn direct_illumination_equals_the_reference_with_the_same_samples() {
 
 #[test]
 fn standard_silhouettes_underestimate_the_penumbra_of_a_large_close_light() {
-    let setup = shadow_core::scenes::builtin("large-light-close").unwrap();
+    let setup = shadow_scenes::builtin("large-light-close").unwrap();
     let view = view_of(&setup, 64, 48);
     let accurate = Dcs::new(64, SamplingStrategy::Stratified, 1).unwrap();
     let standard = Dcs::new(64, SamplingStrategy::Stratified, 1)
@@ -85,10 +87,10 @@ fn standard_silhouettes_underestimate_the_penumbra_of_a_large_close_light() {
 fn narrow_counters_overflow_into_wider_ones_without_changing_the_answer() {
     // 300 stacked quads between a floor and the light: depth complexity 300 in the umbra.
     let mut b = SceneBuilder::new();
-    let f = shadow_core::procedural::floor(8.0, 0.0);
+    let f = shadow_scenes::procedural::floor(8.0, 0.0);
     b.push_mesh(MeshDesc::new(f.0, f.1)).unwrap();
     for k in 0..300 {
-        let q = shadow_core::procedural::quad(
+        let q = shadow_scenes::procedural::quad(
             Vec3::new(0.0, 1.0 + k as f32 * 0.002, 0.0),
             Vec3::X * 0.5,
             Vec3::Z * 0.5,
@@ -159,7 +161,7 @@ fn segment_distance(p: DVec3, q: DVec3, a: DVec3, b: DVec3) -> f64 {
 #[test]
 fn remaining_disagreements_are_numerical_ties() {
     // Many overlapping thin occluders: the hardest built-in case for agreement.
-    let setup = shadow_core::scenes::builtin("grass").unwrap();
+    let setup = shadow_scenes::builtin("grass").unwrap();
     let view = view_of(&setup, 32, 24);
     let dcs = Dcs::new(64, SamplingStrategy::Stratified, 5).unwrap();
     let r = same_samples_reference(&dcs);
@@ -213,13 +215,13 @@ fn remaining_disagreements_are_numerical_ties() {
 /// of any length).
 #[test]
 fn every_number_of_sample_words_agrees_with_the_reference() {
-    let setup = shadow_core::scenes::builtin("bunny").unwrap();
+    let setup = shadow_scenes::builtin("bunny").unwrap();
     let view = view_of(&setup, 40, 30);
     for n in [64, 100, 192, 256, 320] {
         let dcs = Dcs::new(n, SamplingStrategy::Stratified, 6).unwrap();
         let r = same_samples_reference(&dcs);
         let (d, e) = (run(&dcs, &setup, &view), run(&r, &setup, &view));
-        let m = shadow_core::metrics::compare(&d.visibility, &e.visibility).unwrap();
+        let m = shadow_metrics::compare(&d.visibility, &e.visibility).unwrap();
         assert!(m.sample_agreement.unwrap() >= 0.9999, "{n} samples: {m:?}");
         // The pixels took per-sample work, through the light-plane test.
         assert!(
@@ -235,7 +237,7 @@ fn every_number_of_sample_words_agrees_with_the_reference() {
 
 #[test]
 fn concave_polygon_lights_and_every_sampling_strategy_agree_with_the_reference() {
-    let setup = shadow_core::scenes::builtin("bunny").unwrap();
+    let setup = shadow_scenes::builtin("bunny").unwrap();
     let view = view_of(&setup, 40, 30);
     let c = setup.lights[0].center();
     // An L-shaped light facing down, 1.2 across, at the scene light's centre.
@@ -285,11 +287,11 @@ fn concave_polygon_lights_and_every_sampling_strategy_agree_with_the_reference()
 fn refined_tables_give_the_exact_depth_complexity() {
     let strategy = SamplingStrategy::Interleaved { tile: 4 };
     let (mut scenes, mut cells) = (0, 0);
-    for name in shadow_core::scenes::BUILTIN_SCENES {
+    for name in shadow_scenes::BUILTIN_SCENES {
         if name == "grass" {
             continue;
         }
-        let setup = shadow_core::scenes::builtin(name).unwrap();
+        let setup = shadow_scenes::builtin(name).unwrap();
         let view = view_of(&setup, 96, 72);
         let make = |c| {
             Dcs::new(64, strategy, 5)

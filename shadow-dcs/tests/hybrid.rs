@@ -4,10 +4,13 @@
 //! traces `grass` and none of `bunny`), and where rays must not be used (semi-opaque scenes,
 //! depth complexities asked for).
 
+use std::sync::Arc;
+
 use shadow_core::prelude::*;
 use shadow_core::visibility::PerSampleVisibility;
 use shadow_dcs::{Dcs, PerSampleOutput, RayChoice};
-use shadow_ref::Reference;
+use shadow_io::SceneSetup;
+use shadow_ref::{BvhRays, Reference};
 
 fn view_of(setup: &SceneSetup, w: u32, h: u32) -> ViewSamples {
     ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), w, h).unwrap()
@@ -39,10 +42,12 @@ fn tracing_every_square_gives_the_answers_of_dcs_and_the_reference() {
         "cornell-box",
         "large-light-close",
     ] {
-        let setup = shadow_core::scenes::builtin(scene).unwrap();
+        let setup = shadow_scenes::builtin(scene).unwrap();
         let view = view_of(&setup, 48, 36);
         let dcs = Dcs::new(64, SamplingStrategy::Stratified, 5).unwrap();
-        let hybrid = dcs.clone().with_rays(RayChoice::EVERYWHERE);
+        let hybrid = dcs
+            .clone()
+            .with_rays(RayChoice::EVERYWHERE, Arc::new(BvhRays));
         let reference = Reference::same_samples(dcs.light_sampler().unwrap().clone());
         let with_direct = Outputs {
             per_sample: true,
@@ -52,14 +57,14 @@ fn tracing_every_square_gives_the_answers_of_dcs_and_the_reference() {
         let d = run(&dcs, &setup, &view, with_direct);
         let r = run(&reference, &setup, &view, with_direct);
         for (other, name) in [(&d, "dcs"), (&r, "reference")] {
-            let m = shadow_core::metrics::compare(&h.visibility, &other.visibility).unwrap();
+            let m = shadow_metrics::compare(&h.visibility, &other.visibility).unwrap();
             assert!(
                 m.sample_agreement.unwrap() >= 0.9999,
                 "{scene} against {name}: {m:?}"
             );
         }
         // Against the reference on the same samples the traced answers are the reference's.
-        let m = shadow_core::metrics::compare(&h.visibility, &r.visibility).unwrap();
+        let m = shadow_metrics::compare(&h.visibility, &r.visibility).unwrap();
         assert_eq!(m.sample_agreement, Some(1.0), "{scene}");
         assert!(m.rmse <= 1e-6, "{scene}: {m:?}");
         let (a, b) = (h.direct.unwrap(), r.direct.unwrap());
@@ -88,15 +93,15 @@ fn tracing_every_square_gives_the_answers_of_dcs_and_the_reference() {
 #[test]
 fn the_measured_choice_traces_grass_and_not_bunny() {
     for (scene, traced) in [("grass", true), ("bunny", false)] {
-        let setup = shadow_core::scenes::builtin(scene).unwrap();
+        let setup = shadow_scenes::builtin(scene).unwrap();
         let view = view_of(&setup, 64, 48);
         let dcs = Dcs::new(64, SamplingStrategy::Stratified, 2)
             .unwrap()
-            .with_rays(RayChoice::default());
+            .with_rays(RayChoice::default(), Arc::new(BvhRays));
         let reference = Reference::same_samples(dcs.light_sampler().unwrap().clone());
         let h = run(&dcs, &setup, &view, BITS);
         let r = run(&reference, &setup, &view, BITS);
-        let m = shadow_core::metrics::compare(&h.visibility, &r.visibility).unwrap();
+        let m = shadow_metrics::compare(&h.visibility, &r.visibility).unwrap();
         assert!(m.sample_agreement.unwrap() >= 0.9999, "{scene}: {m:?}");
         let squares = h.stats.counter("squares-traced").unwrap();
         assert_eq!(squares > 0, traced, "{scene}: {squares} squares traced");
@@ -126,13 +131,14 @@ fn rays_stay_out_of_semi_opaque_scenes_and_depth_complexities() {
         ("bunny", PerSampleOutput::Counters),
     ];
     for (scene, output) in cases {
-        let setup = shadow_core::scenes::builtin(scene).unwrap();
+        let setup = shadow_scenes::builtin(scene).unwrap();
         let view = view_of(&setup, 40, 30);
         let dcs = Dcs::new(64, SamplingStrategy::Stratified, 4)
             .unwrap()
             .with_per_sample(output);
         let h = run(
-            &dcs.clone().with_rays(RayChoice::EVERYWHERE),
+            &dcs.clone()
+                .with_rays(RayChoice::EVERYWHERE, Arc::new(BvhRays)),
             &setup,
             &view,
             BITS,

@@ -5,9 +5,9 @@
 //! borders (interleaved sets).
 
 use shadow_core::prelude::*;
-use shadow_core::scenes::{BUILTIN_SCENES, builtin};
 use shadow_dcs::paper::{BELOW_HORIZON, paper_depth_complexity};
 use shadow_dcs::{CoveredSamples, Dcs, PerSampleOutput, Silhouettes};
+use shadow_scenes::{BUILTIN_SCENES, builtin};
 
 fn compare(scene: &str, dcs: Dcs, strategy_name: &str) -> Option<(u64, u64, u64)> {
     let setup = builtin(scene).unwrap();

@@ -6,8 +6,9 @@
 
 use shadow_core::prelude::*;
 use shadow_core::sampling::SamplingStrategy;
-use shadow_core::scenes::builtin;
 use shadow_dcs::{CoveredSamples, Dcs};
+use shadow_io::SceneSetup;
+use shadow_scenes::builtin;
 
 fn view_of(setup: &SceneSetup, w: u32, h: u32) -> ViewSamples {
     ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), w, h).unwrap()

@@ -25,7 +25,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let scene = args.first().map_or("bunny", String::as_str);
     let w: u32 = args.get(1).map_or(Ok(160), |s| s.parse())?;
     let h: u32 = args.get(2).map_or(Ok(120), |s| s.parse())?;
-    let setup = shadow_core::scenes::builtin(scene)?;
+    let setup = shadow_scenes::builtin(scene)?;
     let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), w, h)?;
     let r = Reference::stratified(64, 1)?;
     let r_prepared = r.prepare_reference(setup.scene.clone(), setup.lights[0].clone())?;
@@ -81,7 +81,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 fn export(
     dir: &std::path::Path,
     scene: &str,
-    setup: &shadow_core::load::SceneSetup,
+    setup: &shadow_io::load::SceneSetup,
     segs: &[Segment],
 ) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;

@@ -448,7 +448,7 @@ impl PreparedAdaptive {
             }
         }
         if wants.direct {
-            let albedo = p.scene.albedo_at(s.triangle as usize, s.position);
+            let albedo = s.albedo_in(p.scene.as_ref());
             let point = light.area() == 0.0;
             for (y, &v) in buf.samples.iter().zip(vis) {
                 if v > 0.0 {
@@ -575,6 +575,20 @@ fn neighbourhood_variance(probe: &[Acc], w: usize, h: usize, x: usize, y: usize)
     if n == 0 { 0.0 } else { sum / f64::from(n) }
 }
 
+/// The variance pixel `i` plans with where the receivers are no image: the mean of the probe's
+/// replicate variances over `i` and the sampled pixels of `list` (its nearest receivers).
+fn listed_variance(probe: &[Acc], i: usize, list: &[u32]) -> f64 {
+    let (mut sum, mut n) = (0.0, 0u32);
+    for j in std::iter::once(i).chain(list.iter().map(|&j| j as usize)) {
+        let a = &probe[j];
+        if a.valid && !a.clear {
+            sum += a.replicate_var;
+            n += 1;
+        }
+    }
+    if n == 0 { 0.0 } else { sum / f64::from(n) }
+}
+
 /// The progressive-set size of every pixel with variance `c_i` (0 where nothing is sampled):
 /// `n_i = K c_i^(2/5)` within `[B, largest]`, `K` such that the modelled image MSE
 /// `sum c_i (n_i / B)^-3/2 / pixels` is `target^2`, each count rounded to the nearest of
@@ -637,7 +651,11 @@ impl PreparedShadows for PreparedAdaptive {
         &self.inner.stats
     }
 
-    fn estimate(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError> {
+    fn light(&self) -> &dyn AreaLight {
+        self.inner.p.light.as_ref()
+    }
+
+    fn check_outputs(&self, outputs: Outputs) -> Result<(), TechniqueError> {
         if outputs.per_sample {
             return Err(TechniqueError::unsupported(
                 &self.config.name,
@@ -648,6 +666,38 @@ impl PreparedShadows for PreparedAdaptive {
                 ),
             ));
         }
+        Ok(())
+    }
+
+    /// The adaptive pass computes direct light beside the visibility, from the same samples.
+    /// Receivers without a camera are laid out along a space-filling curve first
+    /// ([`shadow_core::receivers::SpatialOrder`]), since the variance is pooled over image
+    /// neighbours, and answered in the caller's order.
+    fn pass(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError> {
+        if view.raster_view().is_some() {
+            return self.image_pass(view, outputs, None);
+        }
+        let order = view.spatially_ordered();
+        // The 3 x 3 neighbourhood's eight, found in space.
+        let neighbours = order.neighbours::<8>(POINT_NEIGHBOUR_WINDOW);
+        let est = self.image_pass(&order.view, outputs, Some(&neighbours))?;
+        order.restore(view, est)
+    }
+}
+
+/// How far along the space-filling curve the neighbours of a receiver without a camera are
+/// looked for, each way.
+const POINT_NEIGHBOUR_WINDOW: usize = 24;
+
+impl PreparedAdaptive {
+    /// The pass on receivers laid out as an image: each pixel's variance is pooled over its
+    /// 3 x 3 neighbourhood, or over `neighbours` (pixel lists) where the layout is not an image.
+    fn image_pass(
+        &self,
+        view: &ViewSamples,
+        outputs: Outputs,
+        neighbours: Option<&[Vec<u32>]>,
+    ) -> Result<Estimate, TechniqueError> {
         let textured = self.inner.p.light.is_textured();
         let wants = Wants {
             textured,
@@ -680,10 +730,12 @@ impl PreparedShadows for PreparedAdaptive {
             let vars: Vec<f64> = (0..w * h)
                 .map(|i| {
                     let a = &flat[i];
-                    if a.valid && !a.clear {
-                        neighbourhood_variance(&flat, w, h, i % w, i / w)
-                    } else {
+                    if !a.valid || a.clear {
                         0.0
+                    } else if let Some(lists) = neighbours {
+                        listed_variance(&flat, i, &lists[i])
+                    } else {
+                        neighbourhood_variance(&flat, w, h, i % w, i / w)
                     }
                 })
                 .collect();
@@ -781,7 +833,6 @@ impl PreparedShadows for PreparedAdaptive {
         vis.validate()?;
         let mut est = Estimate::new(vis, stats);
         est.direct = direct_out;
-        est.darken_behind_light(view, self.inner.p.light.as_ref());
         Ok(est)
     }
 }

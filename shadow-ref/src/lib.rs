@@ -21,7 +21,7 @@
 //! use shadow_core::prelude::*;
 //! use shadow_ref::Reference;
 //!
-//! let setup = shadow_core::scenes::builtin("quad-over-plane").unwrap();
+//! let setup = shadow_scenes::builtin("quad-over-plane").unwrap();
 //! let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 24, 18).unwrap();
 //! let r = Reference::stratified(64, 1).unwrap();
 //! let prepared = r.prepare(setup.scene.clone(), setup.lights[0].clone()).unwrap();
@@ -35,12 +35,12 @@ pub mod adaptive;
 pub mod beam;
 pub mod bvh;
 pub mod offset;
-mod presets;
+pub mod rays;
 pub mod reference;
 pub mod sah;
 pub mod watertight;
 pub mod wide;
 
 pub use adaptive::AdaptiveReference;
-pub use presets::presets;
+pub use rays::BvhRays;
 pub use reference::{PixelScratch, PreparedReference, Reference};

@@ -522,14 +522,17 @@ impl PreparedShadows for PreparedReference {
         &self.stats
     }
 
-    fn estimate(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError> {
+    fn light(&self) -> &dyn AreaLight {
+        self.p.light.as_ref()
+    }
+
+    fn pass(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError> {
         let per_sample = self.config.per_sample || outputs.per_sample;
-        let mut est = self.config.run(&self.p, view, per_sample)?;
-        if outputs.direct {
-            est.direct = Some(est.stats.time("direct", || self.direct_illumination(view)));
-        }
-        est.darken_behind_light(view, self.p.light.as_ref());
-        Ok(est)
+        self.config.run(&self.p, view, per_sample)
+    }
+
+    fn direct_light(&self, view: &ViewSamples, _: &Estimate) -> Result<Vec<Vec3>, TechniqueError> {
+        Ok(self.direct_illumination(view))
     }
 }
 
@@ -608,7 +611,7 @@ impl PreparedReference {
                 let rb = c.receiver_beam(p, &s, samples.len(), &mut scratch);
                 c.sample_visibility(p, &s, &rb, &samples, &mut scratch);
                 let vis = &scratch.vis;
-                let albedo = p.scene.albedo_at(s.triangle as usize, s.position);
+                let albedo = s.albedo_in(p.scene.as_ref());
                 let light: &dyn AreaLight = if c.source == SampleSource::Hard {
                     &HardLight(p.light.center())
                 } else {

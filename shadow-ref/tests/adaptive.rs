@@ -3,9 +3,11 @@
 //! it is deterministic whatever the thread count, and bad configurations are errors.
 
 use shadow_core::prelude::*;
-use shadow_core::scenes::builtin;
+use shadow_io::SceneSetup;
+use shadow_metrics::compare;
 use shadow_ref::adaptive::{DEFAULT_BATCH, DEFAULT_CAP, SAMPLES_COUNTER};
 use shadow_ref::{AdaptiveReference, Reference};
+use shadow_scenes::builtin;
 
 fn estimate(t: &dyn ShadowTechnique, setup: &SceneSetup, view: &ViewSamples) -> Estimate {
     let p = t

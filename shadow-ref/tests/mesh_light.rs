@@ -7,8 +7,9 @@ use std::sync::Arc;
 
 use shadow_core::light::LightKind;
 use shadow_core::prelude::*;
-use shadow_core::scenes::{builtin, folded_lamp};
+use shadow_io::SceneSetup;
 use shadow_ref::Reference;
+use shadow_scenes::{builtin, folded_lamp};
 
 fn visibility(setup: &SceneSetup, light: Light, view: &ViewSamples, seed: u64) -> VisibilityImage {
     Reference::stratified(1024, seed)

@@ -5,10 +5,11 @@ use std::sync::Arc;
 
 use glam::{DVec2, UVec2, Vec3};
 use shadow_core::prelude::*;
-use shadow_core::procedural::{floor, quad, uv_sphere};
-use shadow_core::scenes::{BUILTIN_SCENES, builtin, quad_over_plane as q};
+use shadow_io::SceneSetup;
 use shadow_ref::Reference;
 use shadow_ref::watertight::ShearedRay;
+use shadow_scenes::procedural::{floor, quad, uv_sphere};
+use shadow_scenes::{BUILTIN_SCENES, builtin, quad_over_plane as q};
 
 fn run(r: &Reference, setup: &SceneSetup, view: &ViewSamples) -> VisibilityImage {
     let r_prepared = r

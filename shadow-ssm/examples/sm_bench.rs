@@ -12,9 +12,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let name = args.get(1).map_or("bunny", |s| s.as_str());
     let res: u32 = args.get(2).map_or(Ok(1024), |s| s.parse())?;
     let reps: usize = args.get(3).map_or(Ok(10), |s| s.parse())?;
-    let setup = match shadow_core::corpus::corpus_scene(name) {
+    let setup = match shadow_scenes::corpus::corpus_scene(name) {
         Some(s) => s?,
-        None => shadow_core::scenes::builtin(name)?,
+        None => shadow_scenes::builtin(name)?,
     };
     let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 128, 96)?;
     let receivers: Vec<glam::Vec3> = (0..view.len())

@@ -20,7 +20,7 @@
 //! use shadow_core::prelude::*;
 //! use shadow_ssm::{Filter, ShadowMapFilter};
 //!
-//! let setup = shadow_core::scenes::builtin("quad-over-plane").unwrap();
+//! let setup = shadow_scenes::builtin("quad-over-plane").unwrap();
 //! let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 32, 24).unwrap();
 //! let pcss = ShadowMapFilter::new("pcss", Filter::Pcss, 256);
 //! let prepared = pcss.prepare(setup.scene.clone(), setup.lights[0].clone()).unwrap();
@@ -31,20 +31,21 @@
 #![deny(missing_docs)]
 
 pub mod backprojection;
-mod budgets;
 pub mod contours;
 pub mod hierarchy;
 pub mod light_domain;
 pub mod light_frame;
 pub mod light_space;
 pub mod light_view;
-mod presets;
 pub mod rect_union;
 pub mod screen_space;
 pub mod shadow_map;
 pub mod technique;
 
 pub use light_space::Contours;
-pub use presets::{PEELING_MAX_BIAS, presets};
+
+/// The cap on a midpoint's distance beyond its layer (BCS06 Fig. 5b) that the `ssm-peeling`
+/// preset uses, in world units: about a tenth of the built-in scenes' occluder heights.
+pub const PEELING_MAX_BIAS: f32 = 0.05;
 pub use screen_space::ScreenSpace;
 pub use technique::{Filter, ShadowMapFilter};

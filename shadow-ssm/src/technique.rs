@@ -356,6 +356,8 @@ impl ShadowTechnique for ShadowMapFilter {
             needs_closed_meshes: false,
             sample_based: false,
             processor: Processor::Cpu,
+            // GBP07's screen-space selection works in the camera's image.
+            needs_camera: self.screen_space.is_some(),
         }
     }
 
@@ -412,7 +414,11 @@ impl PreparedShadows for PreparedFilter {
         &self.stats
     }
 
-    fn estimate(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError> {
+    fn light(&self) -> &dyn AreaLight {
+        self.p.light.as_ref()
+    }
+
+    fn check_outputs(&self, outputs: Outputs) -> Result<(), TechniqueError> {
         if outputs.direct {
             return Err(TechniqueError::unsupported(
                 &self.config.name,
@@ -421,9 +427,11 @@ impl PreparedShadows for PreparedFilter {
                 ),
             ));
         }
-        let mut est = self.config.run(&self.p, view)?;
-        est.darken_behind_light(view, self.p.light.as_ref());
-        Ok(est)
+        Ok(())
+    }
+
+    fn pass(&self, view: &ViewSamples, _outputs: Outputs) -> Result<Estimate, TechniqueError> {
+        self.config.run(&self.p, view)
     }
 }
 
@@ -505,8 +513,21 @@ impl ShadowMapFilter {
             (d.full().radiance / d.area().max(f64::MIN_POSITIVE)).as_vec3()
         });
         let camera = view.raster_view();
-        let (l, r, _, _, _, perspective) = camera.extents();
-        let eta = view.width() as f32 / (r - l);
+        if camera.is_none() && self.screen_space.is_some() {
+            return Err(TechniqueError::unsupported(
+                &self.name,
+                UnsupportedReason::View(
+                    "screen-space adaptive selection (GBP07 section 5) works in the camera's \
+                     image; these receivers have no camera"
+                        .into(),
+                ),
+            ));
+        }
+        // Pixels per unit of image plane at unit depth (the screen-space selection's scale).
+        let (perspective, eta) = camera.map_or((false, 1.0), |c| {
+            let (l, r, _, _, _, perspective) = c.extents();
+            (perspective, view.width() as f32 / (r - l))
+        });
         let selection = match (self.screen_space, self.filter) {
             (Some(s), Filter::Contours(_)) => Some(stats.time("discontinuities", || {
                 let spacing = s.pattern.clamp(2, 16).next_power_of_two() as usize;
@@ -594,11 +615,12 @@ impl ShadowMapFilter {
                                     plane: cx.sm.inverse_plane(origins[i], s.geometric_normal),
                                     bias: texel + 1e-6 * p.extent,
                                 };
-                                let to_eye = match eye {
-                                    Some(e) => (e - s.position).normalize_or_zero(),
-                                    None => {
-                                        camera.view_from_world.inverse().transform_vector3(Vec3::Z)
+                                let to_eye = match (eye, camera) {
+                                    (Some(e), _) => (e - s.position).normalize_or_zero(),
+                                    (None, Some(c)) => {
+                                        c.view_from_world.inverse().transform_vector3(Vec3::Z)
                                     }
+                                    (None, None) => s.geometric_normal,
                                 };
                                 let z_pe = if perspective { s.depth } else { 1.0 };
                                 self.shade(

@@ -3,6 +3,8 @@
 
 use shadow_core::prelude::*;
 use shadow_core::visibility::Coefficients;
+use shadow_io::SceneSetup;
+use shadow_metrics::compare;
 use shadow_ssm::backprojection::Backprojection;
 use shadow_ssm::{Contours, Filter, ScreenSpace, ShadowMapFilter};
 
@@ -13,7 +15,7 @@ struct Case {
 }
 
 fn case(scene: &str, w: u32, h: u32) -> Case {
-    let setup = shadow_core::scenes::builtin(scene).unwrap();
+    let setup = shadow_scenes::builtin(scene).unwrap();
     let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), w, h).unwrap();
     let r = shadow_ref::Reference::stratified(1024, 1).unwrap();
     let r_prepared = r

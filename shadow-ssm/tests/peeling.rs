@@ -11,7 +11,7 @@ use shadow_ssm::{Filter, ShadowMapFilter};
 
 /// RMSE and bias of `filter` with `layers` layers against a 1024-sample reference on `scene`.
 fn error(scene: &str, filter: Backprojection, layers: u32) -> (f64, f64) {
-    let setup = shadow_core::scenes::builtin(scene).unwrap();
+    let setup = shadow_scenes::builtin(scene).unwrap();
     let view =
         ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 64, 48).unwrap();
     let run = |t: &dyn ShadowTechnique| {
@@ -24,7 +24,7 @@ fn error(scene: &str, filter: Backprojection, layers: u32) -> (f64, f64) {
     let truth = run(&shadow_ref::Reference::stratified(1024, 3).unwrap());
     let t =
         ShadowMapFilter::new("peeling", Filter::Backprojection(filter), 1024).with_layers(layers);
-    let m = shadow_core::metrics::compare(&run(&t), &truth).unwrap();
+    let m = shadow_metrics::compare(&run(&t), &truth).unwrap();
     (m.rmse, m.bias)
 }
 

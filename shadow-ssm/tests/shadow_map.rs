@@ -3,6 +3,7 @@
 use glam::Vec3;
 use shadow_core::light::{Radiance, RectLight};
 use shadow_core::prelude::*;
+use shadow_metrics::compare;
 use shadow_ssm::light_frame::LightFrame;
 use shadow_ssm::shadow_map::ShadowMap;
 use shadow_ssm::{Filter, ShadowMapFilter};
@@ -39,9 +40,9 @@ fn fraction_of_the_light_above_a_plane_is_exact() {
 fn shadow_map_depths_equal_the_distance_to_the_light_plane_and_eq1_holds() {
     // A floor at y = 0 and a square occluder at y = 1.5 under a light at y = 4.
     let mut b = SceneBuilder::new();
-    let f = shadow_core::procedural::floor(6.0, 0.0);
+    let f = shadow_scenes::procedural::floor(6.0, 0.0);
     b.push_mesh(MeshDesc::new(f.0, f.1)).unwrap();
-    let q = shadow_core::procedural::quad(Vec3::new(0.0, 1.5, 0.0), Vec3::X * 0.4, Vec3::Z * 0.4);
+    let q = shadow_scenes::procedural::quad(Vec3::new(0.0, 1.5, 0.0), Vec3::X * 0.4, Vec3::Z * 0.4);
     b.push_mesh(MeshDesc::new(q.0, q.1)).unwrap();
     let scene = b.build().unwrap();
     let frame = LightFrame::new(&light(), "t").unwrap();
@@ -75,7 +76,7 @@ fn shadow_map_depths_equal_the_distance_to_the_light_plane_and_eq1_holds() {
 
 #[test]
 fn pcss_is_closer_to_the_reference_than_pcf_under_a_planar_occluder() {
-    let setup = shadow_core::scenes::builtin("quad-over-plane").unwrap();
+    let setup = shadow_scenes::builtin("quad-over-plane").unwrap();
     let view =
         ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 64, 48).unwrap();
     let run = |t: &dyn ShadowTechnique| {
@@ -105,7 +106,7 @@ fn pcss_is_closer_to_the_reference_than_pcf_under_a_planar_occluder() {
     assert!(pcss.rmse < 0.02, "{pcss:?}");
     assert!(pcf.rmse > 3.0 * pcss.rmse, "{pcf:?} {pcss:?}");
     // Sphere lights are refused with the reason.
-    let sphere = shadow_core::scenes::builtin("sphere-light").unwrap();
+    let sphere = shadow_scenes::builtin("sphere-light").unwrap();
     let t = ShadowMapFilter::new("pcss", Filter::Pcss, 64);
     let err = t
         .prepare(sphere.scene.clone(), sphere.lights[0].clone())
@@ -120,10 +121,10 @@ fn pcss_is_closer_to_the_reference_than_pcf_under_a_planar_occluder() {
 #[test]
 fn occluders_beside_a_small_view_stay_in_the_map() {
     let mut b = SceneBuilder::new();
-    let f = shadow_core::procedural::floor(20.0, 0.0);
+    let f = shadow_scenes::procedural::floor(20.0, 0.0);
     b.push_mesh(MeshDesc::new(f.0, f.1)).unwrap();
     // A plate just under a wide light, beside the small patch the camera sees.
-    let plate = shadow_core::procedural::quad(
+    let plate = shadow_scenes::procedural::quad(
         Vec3::new(0.6, 2.8, 0.0),
         Vec3::new(0.5, 0.0, 0.0),
         Vec3::new(0.0, 0.0, 0.8),
@@ -164,7 +165,7 @@ fn occluders_beside_a_small_view_stay_in_the_map() {
     assert!(t < 0.9, "the plate must shadow the patch: mean V {t}");
     // The presets that integrate over the light (PCF and PCSS filter around the light centre's
     // projection and are held to their own budgets elsewhere).
-    for p in shadow_ssm::presets()
+    for p in shadow_presets::ssm::presets()
         .into_iter()
         .filter(|p| p.name.starts_with("ssm-"))
     {
@@ -186,7 +187,7 @@ fn occluders_beside_a_small_view_stay_in_the_map() {
 /// there. Every shadow-map filter refuses it with the reason instead.
 #[test]
 fn a_room_around_a_recessed_light_is_refused_not_drawn_wrong() {
-    let setup = shadow_core::scenes::builtin("cornell-box").unwrap();
+    let setup = shadow_scenes::builtin("cornell-box").unwrap();
     let view =
         ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 32, 24).unwrap();
     for filter in [Filter::Pcf { radius: 2 }, Filter::Pcss] {
@@ -199,7 +200,7 @@ fn a_room_around_a_recessed_light_is_refused_not_drawn_wrong() {
         assert!(reason.contains("degrees off the light's axis"), "{reason}");
     }
     // The same filters still draw the built-in scenes (all within 80 degrees).
-    let setup = shadow_core::scenes::builtin("large-light-close").unwrap();
+    let setup = shadow_scenes::builtin("large-light-close").unwrap();
     let view =
         ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 32, 24).unwrap();
     let t = ShadowMapFilter::new("t", Filter::Pcss, 256);

@@ -8,7 +8,7 @@
 //! ```
 //!
 //! After the built-in scenes come scenes of the corpus of real meshes
-//! (`shadow_core::corpus`): a small share by default (`corpus_share`: every mesh once, the
+//! (`shadow_scenes::corpus`): a small share by default (`corpus_share`: every mesh once, the
 //! lights in turn), all 44 with `SHADOW_TEST_CORPUS=all` (how the corpus rows of the budget
 //! tables are measured). `cargo xtask conformance --corpus` runs them all with the report.
 //!
@@ -22,13 +22,16 @@ use std::sync::{Arc, OnceLock};
 use libtest_mimic::{Arguments, Failed, Trial};
 use shadow_conformance::closed_form::{masked, quad_over_plane_buffer};
 use shadow_conformance::conformance::{
-    GPU_TEST_RESOLUTION, Outcome, SceneContext, SuiteConfig, run_case,
+    GPU_TEST_RESOLUTION, Outcome, ReceiverMode, SceneContext, SuiteConfig, run_case,
 };
-use shadow_conformance::registry;
-use shadow_core::corpus::{corpus_scene_names, corpus_share};
-use shadow_core::preset::Preset;
-use shadow_core::scenes::{BUILTIN_SCENES, builtin};
 use shadow_core::technique::{Processor, UnsupportedReason};
+use shadow_presets::Preset;
+use shadow_presets::registry;
+use shadow_scenes::corpus::{corpus_scene_names, corpus_share};
+use shadow_scenes::{BUILTIN_SCENES, builtin};
+
+/// The scenes every preset runs on with foreign receivers in `cargo test`.
+const FOREIGN_RECEIVER_SCENES: [&str; 2] = ["bunny", "interior"];
 
 /// A scene's context, built by the first case that needs it and shared by the others.
 struct LazyContext {
@@ -131,7 +134,7 @@ fn conformance_case(preset: Preset, ctx: &SceneContext) -> Result<(), Failed> {
 fn closed_form_case(preset: Preset, ctx: &SceneContext) -> Result<(), Failed> {
     let (exact, mask) = quad_over_plane_buffer(&ctx.view);
     let reference = masked(&ctx.reference()?.0, &mask);
-    let m = shadow_core::metrics::compare(&reference, &exact).map_err(|e| e.to_string())?;
+    let m = shadow_metrics::compare(&reference, &exact).map_err(|e| e.to_string())?;
     if !(m.rmse < 4e-3 && m.max_abs < 0.03) {
         return Err(format!("reference vs closed form: {m:?}").into());
     }
@@ -143,8 +146,8 @@ fn closed_form_case(preset: Preset, ctx: &SceneContext) -> Result<(), Failed> {
         }
         Outcome::Failed { error } => return Err(format!("{}: {error}", preset.name).into()),
     };
-    let m = shadow_core::metrics::compare(&masked(&r.estimate, &mask), &exact)
-        .map_err(|e| e.to_string())?;
+    let m =
+        shadow_metrics::compare(&masked(&r.estimate, &mask), &exact).map_err(|e| e.to_string())?;
     let b = (preset.budget)("quad-over-plane").ok_or("no budget for quad-over-plane")?;
     println!(
         "{:<24} vs closed form: rmse {:.5} max {:.4}",
@@ -153,7 +156,7 @@ fn closed_form_case(preset: Preset, ctx: &SceneContext) -> Result<(), Failed> {
     // A sample-based technique's budget is against the reference on its own samples; against
     // the closed form it may add that reference's sampling error.
     let (noise_rmse, noise_max) = if r.same_samples {
-        let n = shadow_core::metrics::compare(&masked(&r.reference, &mask), &exact)
+        let n = shadow_metrics::compare(&masked(&r.reference, &mask), &exact)
             .map_err(|e| e.to_string())?;
         (n.rmse, n.max_abs)
     } else {
@@ -206,6 +209,38 @@ fn main() {
                 format!("conformance/{}/{scene}", p.name),
                 move || conformance_case(p, ctx.get()?),
             ));
+        }
+    }
+    // Receivers handed in as another renderer would: every preset on scenes of both kinds
+    // (a mesh under a large light, a room around the light), as a foreign G-buffer with the
+    // camera and as shuffled points without one; `cargo xtask conformance --receivers` runs
+    // every scene.
+    for mode in [ReceiverMode::Gbuffer, ReceiverMode::Points] {
+        for scene in FOREIGN_RECEIVER_SCENES {
+            let (cpu, gpu) = (
+                LazyContext::new(
+                    scene,
+                    SuiteConfig {
+                        receivers: mode,
+                        ..cfg
+                    },
+                ),
+                LazyContext::new(
+                    scene,
+                    SuiteConfig {
+                        receivers: mode,
+                        ..gpu_cfg
+                    },
+                ),
+            );
+            let label = mode.label();
+            for &p in &presets {
+                let ctx = Arc::clone(if on_gpu(&p, cfg.seed) { &gpu } else { &cpu });
+                trials.push(Trial::test(
+                    format!("{label}/{}/{scene}", p.name),
+                    move || conformance_case(p, ctx.get()?),
+                ));
+            }
         }
     }
     for &p in &presets {

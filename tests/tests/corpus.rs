@@ -1,13 +1,13 @@
-//! Issue 49: the corpus of real meshes (`shadow_core::corpus`) in `cargo test`, a small,
+//! Issue 49: the corpus of real meshes (`shadow_scenes::corpus`) in `cargo test`, a small,
 //! low-resolution share of it (the main measurements are `cargo xtask bench`'s): every corpus
 //! scene loads with its mesh in view and in a shadow, and DCS, which is exact, gives the
 //! reference's answer on the same samples on one light variant of every mesh (no pixel off by
 //! more than two samples' share, the numerical ties).
 
 use shadow_conformance::conformance::{Outcome, SceneContext, SuiteConfig, run_case};
-use shadow_core::corpus::{CORPUS_LIGHTS, CORPUS_MESHES, corpus_scene_names, corpus_share};
 use shadow_core::prelude::*;
-use shadow_core::scenes::builtin;
+use shadow_scenes::builtin;
+use shadow_scenes::corpus::{CORPUS_LIGHTS, CORPUS_MESHES, corpus_scene_names, corpus_share};
 
 fn small() -> SuiteConfig {
     SuiteConfig {
@@ -16,6 +16,7 @@ fn small() -> SuiteConfig {
         ref_samples: 64,
         seed: 1,
         extra_checks: false,
+        ..SuiteConfig::default()
     }
 }
 
@@ -45,7 +46,7 @@ fn every_corpus_scene_loads_in_view_and_in_shadow() {
 
 #[test]
 fn dcs_equals_the_same_samples_reference_on_a_share_of_the_corpus() {
-    let dcs = shadow_conformance::preset("dcs-64").unwrap();
+    let dcs = shadow_presets::preset("dcs-64").unwrap();
     for name in corpus_share() {
         let ctx = SceneContext::new(builtin(&name).unwrap(), small()).unwrap();
         match run_case(&dcs, &ctx) {

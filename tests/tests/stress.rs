@@ -1,7 +1,7 @@
 //! The core stress cases, run against every registered preset at a small size.
 
-use shadow_conformance::registry;
 use shadow_conformance::stress::{input_cases, known_limitation, technique_cases};
+use shadow_presets::registry;
 
 #[test]
 fn bad_input_gives_typed_errors() {

@@ -4,8 +4,8 @@
 //!   2048 samples and the adaptive one at its targets, measured by the budgets sweep; DCS at
 //!   16, 64 and 256 samples; PCF, PCSS and the SSM presets) on every scene, RMSE against the
 //!   independent 4096-sample reference and median time, beside the scene's probe features;
-//! * **fit**: the cost and error models of [`shadow_conformance::auto::model`], written to
-//!   `conformance/auto-model.json` with `--write-model`;
+//! * **fit**: the cost and error models of [`shadow_auto::model`], written to
+//!   `shadow-auto/auto-model.json` with `--write-model`;
 //! * **evaluation**, each scene with the model fitted on the other scenes (leave one out, so
 //!   no scene grades a model it trained): `auto` under RMSE budgets 0.03, 0.01 and 0.003 (met
 //!   or not; time against the fastest configuration of the sweep that met the budget) and
@@ -15,11 +15,10 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use serde::Serialize;
-use shadow_conformance::auto::{
-    Auto, AutoBudget, AutoModel, Config, Features, Observation, measure_features,
-};
-use shadow_core::metrics::compare;
+use shadow_auto::{Auto, AutoBudget, AutoModel, Config, Features, Observation, measure_features};
 use shadow_core::prelude::*;
+use shadow_io::SceneSetup;
+use shadow_metrics::compare;
 
 /// The probe's pixel budget written into the model.
 pub const PROBE_PIXELS: u32 = 768;
@@ -112,7 +111,9 @@ pub fn observe_extra(
 ) -> Result<Vec<Observation>, String> {
     let mut out = Vec::new();
     for config in extra_configs() {
-        let t = config.build(1).map_err(|e| e.to_string())?;
+        let t = config
+            .build(1, shadow_presets::build)
+            .map_err(|e| e.to_string())?;
         let caps = t.capabilities();
         if caps
             .check(run.setup.scene.as_ref(), run.setup.lights[0].as_ref())
@@ -196,7 +197,8 @@ pub fn evaluate(
             .map(|&r| AutoBudget::Rmse(r))
             .chain(TIME_BUDGETS.iter().map(|&s| AutoBudget::Seconds(s)));
         for budget in budgets {
-            let auto = Auto::with_model(budget, 1, model.clone()).map_err(|e| e.to_string())?;
+            let auto = Auto::with_model(budget, 1, model.clone(), shadow_presets::build)
+                .map_err(|e| e.to_string())?;
             let (seconds, e) = timed(&auto, run.setup, run.view, repeats)?;
             let rmse = compare(&e.visibility, run.truth)
                 .map_err(|e| e.to_string())?

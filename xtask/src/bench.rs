@@ -13,14 +13,15 @@ use glam::Vec3;
 use serde::Serialize;
 use serde_json::json;
 use shadow_conformance::conformance::run_technique;
-use shadow_core::image_io::shaded_image;
-use shadow_core::metrics::compare;
 use shadow_core::prelude::*;
-use shadow_core::procedural::{floor, uv_sphere};
-use shadow_core::scenes::{BUILTIN_SCENES, builtin};
+use shadow_io::SceneSetup;
+use shadow_io::image_io::shaded_image;
+use shadow_metrics::compare;
 use shadow_ref::Reference;
+use shadow_scenes::procedural::{floor, uv_sphere};
+use shadow_scenes::{BUILTIN_SCENES, builtin};
 
-use crate::bench_summary::{Measured, tables, write_docs};
+use crate::bench_summary::{Measured, median, tables, write_docs};
 use crate::common::{machine, progress, rays_per_second_per_thread, write_json};
 use crate::ensure_dir;
 use crate::flip::flip;
@@ -93,19 +94,6 @@ struct ScalingPoint {
     seconds: f64,
     triangles: usize,
     pixels: usize,
-}
-
-/// The median (the mean of the middle two for an even count; NaN for none).
-pub(crate) fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n == 0 {
-        f64::NAN
-    } else if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
 }
 
 /// Warm-up plus `repeats` timed runs of a fresh technique: (median seconds, runs, last estimate).
@@ -203,7 +191,7 @@ fn light_size_scene(side: f32) -> Result<SceneSetup, String> {
 
 pub fn run(mut a: BenchArgs) -> Result<(), String> {
     for s in &a.scenes {
-        if !BUILTIN_SCENES.contains(&s.as_str()) && !shadow_core::corpus::is_corpus_scene(s) {
+        if !BUILTIN_SCENES.contains(&s.as_str()) && !shadow_scenes::corpus::is_corpus_scene(s) {
             return Err(format!(
                 "unknown scene `{s}`; valid names: {} and the corpus scenes `cargo xtask scenes` \
                  lists",
@@ -212,12 +200,12 @@ pub fn run(mut a: BenchArgs) -> Result<(), String> {
         }
     }
     if a.corpus {
-        a.scenes.extend(shadow_core::corpus::corpus_scene_names());
+        a.scenes.extend(shadow_scenes::corpus::corpus_scene_names());
     }
     for t in &a.techniques {
-        shadow_conformance::preset(t)?;
+        shadow_presets::preset(t)?;
     }
-    let presets: Vec<_> = shadow_conformance::registry()
+    let presets: Vec<_> = shadow_presets::registry()
         .into_iter()
         .filter(|p| a.techniques.is_empty() || a.techniques.iter().any(|t| t == p.name))
         .collect();
@@ -699,7 +687,7 @@ fn write_summary(a: &BenchArgs, points: &[Point], truth_samples: u32) -> Result<
         if a.corpus { " --corpus" } else { "" },
         a.scenes
             .iter()
-            .filter(|s| !(a.corpus && shadow_core::corpus::is_corpus_scene(s)))
+            .filter(|s| !(a.corpus && shadow_scenes::corpus::is_corpus_scene(s)))
             .cloned()
             .collect::<Vec<_>>()
             .join(","),

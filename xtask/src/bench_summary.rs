@@ -13,8 +13,6 @@ use std::path::Path;
 
 use shadow_conformance::conformance::{CurvePoint, reference_time_at};
 
-use crate::bench::median;
-
 /// One measured point of the study: scene, technique, samples, RMSE, seconds.
 pub struct Measured<'a> {
     /// Scene name.
@@ -174,6 +172,19 @@ pub fn write_docs(page: &Path, table: &str) -> Result<(), String> {
     }
     let out = format!("{}{BEGIN}\n{table}{}", &text[..a], &text[b..]);
     std::fs::write(page, out).map_err(|e| format!("{}: {e}", page.display()))
+}
+
+/// The median (the mean of the middle two for an even count; NaN for none).
+pub(crate) fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        f64::NAN
+    } else if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
 }
 
 #[cfg(test)]

@@ -24,14 +24,15 @@ use std::path::PathBuf;
 use clap::Args;
 use glam::Vec3;
 use serde::Serialize;
-use shadow_conformance::auto::{AutoModel, Config, Observation};
+use shadow_auto::{AutoModel, Config, Observation};
 use shadow_conformance::conformance::{CurvePoint, reference_time_at};
-use shadow_core::metrics::compare;
 use shadow_core::prelude::*;
-use shadow_core::scenes::{BUILTIN_SCENES, builtin};
 use shadow_core::technique::{direct_from_per_sample, ratio_direct_from_per_sample};
+use shadow_io::SceneSetup;
+use shadow_metrics::compare;
 use shadow_ref::adaptive::{DEFAULT_BATCH, DEFAULT_CAP, SAMPLES_COUNTER};
 use shadow_ref::{AdaptiveReference, Reference};
+use shadow_scenes::{BUILTIN_SCENES, builtin};
 
 use crate::auto_study::{self, SceneRun, timed};
 use crate::common::{machine, progress, write_json};
@@ -55,7 +56,7 @@ pub struct BudgetsArgs {
     #[arg(long, default_value_t = 3)]
     repeats: usize,
     /// Also write the fitted `auto` model here (the committed one is
-    /// `conformance/auto-model.json`).
+    /// `shadow-auto/auto-model.json`).
     #[arg(long)]
     write_model: Option<PathBuf>,
     /// Skip the `auto` study (observations, fit and evaluation).
@@ -281,7 +282,7 @@ pub fn run(a: BudgetsArgs) -> Result<(), String> {
                 .with_per_sample(true);
             sources.push((format!("ref-{n}"), Box::new(r)));
         }
-        if let Ok(p) = shadow_conformance::preset("dcs-64") {
+        if let Ok(p) = shadow_presets::preset("dcs-64") {
             sources.push(("dcs-64".into(), (p.make)(1)));
         }
         for (label, t) in sources {

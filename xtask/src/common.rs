@@ -7,9 +7,10 @@ use std::time::Duration;
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
-use shadow_core::load::{LoadLimits, load_scene};
 use shadow_core::prelude::*;
-use shadow_core::scenes::{BUILTIN_SCENES, builtin};
+use shadow_io::SceneSetup;
+use shadow_io::load::{LoadLimits, load_scene};
+use shadow_scenes::{BUILTIN_SCENES, builtin};
 
 /// A built-in scene by name, or a scene file by path. A file without an emissive mesh gets a
 /// square light above its bounds (said on stderr) unless `own_light` (the caller brings one).
@@ -19,7 +20,7 @@ pub fn resolve_scene(
     own_light: bool,
     emissive_as_geometry: bool,
 ) -> Result<SceneSetup, String> {
-    if BUILTIN_SCENES.contains(&name) || shadow_core::corpus::is_corpus_scene(name) {
+    if BUILTIN_SCENES.contains(&name) || shadow_scenes::corpus::is_corpus_scene(name) {
         if emissive_as_geometry {
             return Err(format!(
                 "--emissive-as-geometry applies to scene files; `{name}` is a built-in scene"
@@ -76,13 +77,13 @@ pub fn resolve_technique(
     samples: Option<u32>,
     seed: u64,
 ) -> Result<Box<dyn ShadowTechnique>, String> {
-    let all = shadow_conformance::registry();
+    let all = shadow_presets::registry();
     let settable = |family: &str| {
         all.iter()
             .find(|p| family_of(p.name) == family && p.with_samples.is_some())
             .copied()
     };
-    let p = match shadow_conformance::preset(name) {
+    let p = match shadow_presets::preset(name) {
         Ok(p) => p,
         Err(unknown) => settable(name).ok_or(unknown)?,
     };
@@ -143,14 +144,14 @@ pub fn list_scenes() -> Result<(), String> {
         "\nScaled and translated variants are built by the stress suite (`cargo xtask stress`)."
     );
     println!(
-        "\nThe corpus of real meshes (`shadow_core::corpus`, {} scenes: each mesh at a largest \
+        "\nThe corpus of real meshes (`shadow_scenes::corpus`, {} scenes: each mesh at a largest \
          extent of 1 m on a floor, under a tilted rectangle or a disk light of a quarter or the \
          whole of that extent), by name in render, conformance and bench, all of them with \
          `--corpus` (conformance, bench, stress) or `conformance --scenes corpus`: \
          corpus-<mesh>-<light>\n  meshes: {}\n  lights: {}",
-        shadow_core::corpus::corpus_scene_names().len(),
-        shadow_core::corpus::CORPUS_MESHES.join(", "),
-        shadow_core::corpus::CORPUS_LIGHTS.join(", ")
+        shadow_scenes::corpus::corpus_scene_names().len(),
+        shadow_scenes::corpus::CORPUS_MESHES.join(", "),
+        shadow_scenes::corpus::CORPUS_LIGHTS.join(", ")
     );
     Ok(())
 }

@@ -10,12 +10,12 @@ use std::path::PathBuf;
 use clap::Args;
 use serde_json::json;
 use shadow_conformance::conformance::{
-    BUDGET_RESOLUTION, Outcome, SceneContext, SuiteConfig, reference_curve, reference_time_at,
-    run_case,
+    BUDGET_RESOLUTION, Outcome, ReceiverMode, SceneContext, SuiteConfig, reference_curve,
+    reference_time_at, run_case,
 };
-use shadow_core::image_io::{shaded_image, write_error_png, write_visibility_png};
-use shadow_core::metrics::compare;
-use shadow_core::scenes::{BUILTIN_SCENES, builtin};
+use shadow_io::image_io::{shaded_image, write_error_png, write_visibility_png};
+use shadow_metrics::compare;
+use shadow_scenes::{BUILTIN_SCENES, builtin};
 
 use crate::common::{machine, progress, write_json};
 use crate::ensure_dir;
@@ -64,6 +64,12 @@ pub struct ConformanceArgs {
     /// Skip the determinism and convergence re-runs.
     #[arg(long)]
     quick: bool,
+    /// Where the receivers come from: `camera` (the built-in rasterizer), `gbuffer` (the same
+    /// surfaces as another renderer's float G-buffer with its camera) or `points` (shuffled
+    /// points with normals, no camera). A technique that needs a camera refuses `points` with
+    /// its reason.
+    #[arg(long, default_value = "camera", value_parser = ReceiverMode::parse)]
+    receivers: ReceiverMode,
 }
 
 /// The scenes of a run, in order: the built-in ones named (all of them when no scene is
@@ -77,7 +83,7 @@ fn conformance_scenes(named: &[String], corpus: bool) -> Vec<String> {
         .map(|s| (*s).to_string())
         .collect();
     scenes.extend(
-        shadow_core::corpus::corpus_scene_names()
+        shadow_scenes::corpus::corpus_scene_names()
             .into_iter()
             .filter(|s| corpus || wanted(s)),
     );
@@ -88,12 +94,12 @@ fn conformance_scenes(named: &[String], corpus: bool) -> Vec<String> {
 const CURVE: [u32; 6] = [1, 4, 16, 64, 256, 1024];
 
 pub fn run(a: ConformanceArgs) -> Result<(), String> {
-    let presets = shadow_conformance::registry();
+    let presets = shadow_presets::registry();
     for t in &a.techniques {
-        shadow_conformance::preset(t)?;
+        shadow_presets::preset(t)?;
     }
     for s in &a.scenes {
-        if !shadow_core::scenes::is_named_scene(s) && s != "corpus" {
+        if !shadow_scenes::is_named_scene(s) && s != "corpus" {
             return Err(format!(
                 "unknown scene `{s}`; valid names: {}, the corpus scenes `cargo xtask scenes` \
                  lists, and `corpus` for all of them",
@@ -113,6 +119,7 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
         ref_samples: a.ref_samples,
         seed: a.seed,
         extra_checks: !a.quick,
+        receivers: a.receivers,
     };
     ensure_dir(&a.out)?;
     let pb = progress((scenes.len() * (chosen.len() + 1)) as u64, "conformance");

@@ -55,9 +55,9 @@ pub fn flip(reference: &RgbImage, test: &RgbImage, view: &ViewSamples) -> Result
 #[cfg(test)]
 mod tests {
     use super::*;
-    use shadow_core::image_io::shaded_image;
-    use shadow_core::scenes::builtin;
     use shadow_core::visibility::VisibilityImage;
+    use shadow_io::image_io::shaded_image;
+    use shadow_scenes::builtin;
 
     /// Identical images give 0; a darkened shadow gives more than a slightly darker one.
     #[test]

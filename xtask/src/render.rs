@@ -6,11 +6,12 @@ use std::time::Instant;
 use clap::Args;
 use glam::Vec3;
 use serde_json::json;
-use shadow_core::image_io::{
+use shadow_core::prelude::*;
+use shadow_io::SceneSetup;
+use shadow_io::image_io::{
     write_normal_exr, write_position_exr, write_radiance_png, write_rgb_exr, write_shaded_png,
     write_visibility_exr, write_visibility_png,
 };
-use shadow_core::prelude::*;
 
 use crate::common::{
     machine, progress, rays_per_second_per_thread, resolve_scene, resolve_technique, write_json,
@@ -139,7 +140,7 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
     // Far from the origin, work where single precision is dense (issue 51 item 11); positions
     // are written back in the file's coordinates.
     let mut shift = Vec3::ZERO;
-    if let Some((moved, by)) = shadow_core::scenes::recentred(&setup).map_err(|e| e.to_string())? {
+    if let Some((moved, by)) = shadow_scenes::recentred(&setup).map_err(|e| e.to_string())? {
         setup = moved;
         shift = by;
     }
@@ -293,7 +294,7 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
 
 /// The `auto` chooser under the budget `--rmse` or `--seconds` names (exactly one).
 fn auto_technique(a: &RenderArgs) -> Result<Box<dyn ShadowTechnique>, String> {
-    use shadow_conformance::auto::{Auto, AutoBudget};
+    use shadow_auto::{Auto, AutoBudget};
     if a.samples.is_some() {
         return Err("`auto` chooses its own sample count: give --rmse or --seconds".into());
     }
@@ -303,7 +304,7 @@ fn auto_technique(a: &RenderArgs) -> Result<Box<dyn ShadowTechnique>, String> {
         _ => return Err("--technique auto needs exactly one of --rmse and --seconds".into()),
     };
     Ok(Box::new(
-        Auto::new(budget, a.seed).map_err(|e| e.to_string())?,
+        Auto::new(budget, a.seed, shadow_presets::build).map_err(|e| e.to_string())?,
     ))
 }
 

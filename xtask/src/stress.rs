@@ -30,11 +30,11 @@ pub struct StressArgs {
 
 pub fn run(a: StressArgs) -> Result<(), String> {
     let mut results = input_cases();
-    let presets = shadow_conformance::registry();
+    let presets = shadow_presets::registry();
     let corpus = if a.corpus {
-        shadow_core::corpus::corpus_scene_names()
+        shadow_scenes::corpus::corpus_scene_names()
     } else {
-        shadow_core::corpus::corpus_share()
+        shadow_scenes::corpus::corpus_share()
     };
     for p in &presets {
         if a.techniques.is_empty() || a.techniques.iter().any(|t| t == p.name) {

@@ -24,7 +24,7 @@ fn scenes_lists_every_builtin_scene() {
     let out = xtask(&["scenes"]);
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
-    for name in shadow_core::scenes::BUILTIN_SCENES {
+    for name in shadow_scenes::BUILTIN_SCENES {
         assert!(text.contains(name), "{name} missing from:\n{text}");
     }
 }
@@ -517,8 +517,7 @@ fn a_command_line_light_and_camera_match_the_scene_built_in_code() {
         "no default light with --light: {err}"
     );
     // The same scene, light, camera and technique in code.
-    let setup =
-        shadow_core::load::load_scene(&obj, &shadow_core::load::LoadLimits::default()).unwrap();
+    let setup = shadow_io::load::load_scene(&obj, &shadow_io::load::LoadLimits::default()).unwrap();
     let light: Light = std::sync::Arc::new(
         RectLight::facing(
             glam::Vec3::new(0.2, 2.5, 0.1),

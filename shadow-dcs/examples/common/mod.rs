@@ -4,6 +4,8 @@
 use std::time::Instant;
 
 use shadow_core::prelude::*;
+use shadow_io::SceneSetup;
+use shadow_presets::Preset;
 
 /// Built-in scene `name` and its view samples at `size` x `size` from the scene's camera.
 ///
@@ -14,7 +16,7 @@ pub fn scene_and_view(
     name: &str,
     size: u32,
 ) -> Result<(SceneSetup, ViewSamples), Box<dyn std::error::Error>> {
-    let mut setup = shadow_core::scenes::builtin(name)?;
+    let mut setup = shadow_scenes::builtin(name)?;
     if let Ok(k) = std::env::var("DCS_LIGHT_SCALE") {
         let k: f32 = k
             .parse()
@@ -40,7 +42,7 @@ pub fn scene_and_view(
 
 /// The DCS preset called `name`; `what` names the other accepted arguments in the error.
 pub fn preset(name: &str, what: &str) -> Result<Preset, String> {
-    shadow_dcs::presets()
+    shadow_presets::dcs::presets()
         .into_iter()
         .find(|p| p.name == name)
         .ok_or_else(|| format!("{name}: neither {what} nor a DCS preset"))

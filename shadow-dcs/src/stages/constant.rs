@@ -281,7 +281,7 @@ mod tests {
     use crate::stages::light_shape::LightShape;
     use shadow_core::light::{Radiance, RectLight};
     use shadow_core::prelude::*;
-    use shadow_core::procedural;
+    use shadow_scenes::procedural;
 
     /// The integration constant equals the ray-cast count of faces turned away from `p` that
     /// the segment from `p` to the light centre crosses, on closed meshes.
@@ -323,7 +323,7 @@ mod tests {
             })
             .collect();
         let valid = view.valid_mask();
-        let eye = view.eye().unwrap();
+        let (eye, camera) = view.perspective().unwrap();
         let eye_c = eye_constant(&scene, units, eye, shape.center);
         let centred: Vec<Vec3> = origins
             .iter()
@@ -335,7 +335,7 @@ mod tests {
             shape.center,
             eye,
             eye_c,
-            view.raster_view(),
+            camera,
             &origins,
             &centred,
             &valid,

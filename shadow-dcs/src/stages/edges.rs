@@ -239,7 +239,7 @@ mod tests {
     use super::*;
     use shadow_core::light::{Radiance, RectLight};
     use shadow_core::prelude::*;
-    use shadow_core::procedural;
+    use shadow_scenes::procedural;
 
     fn scene_of(m: procedural::Mesh) -> TriangleScene {
         let mut b = SceneBuilder::new();

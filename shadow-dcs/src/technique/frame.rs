@@ -17,11 +17,12 @@ impl Dcs {
         traceable: bool,
         stats: &mut Stats,
     ) -> Result<(Frame<'a>, Plan<'p>), TechniqueError> {
-        let eye = view.eye().ok_or_else(|| {
+        let (eye, camera) = view.perspective().ok_or_else(|| {
             TechniqueError::unsupported(
                 &self.name,
                 UnsupportedReason::View(
-                    "orthographic views: the shadow-volume step counts quads from an eye point"
+                    "orthographic views and receivers without a camera: the shadow-volume step \
+                     counts quads from an eye point"
                         .into(),
                 ),
             )
@@ -64,7 +65,7 @@ impl Dcs {
             view,
         };
         let plan = stats.time("square-plan", || self.plan(p, &f, traceable));
-        self.integration_constants(p, &mut f, &plan, eye, stats);
+        self.integration_constants(p, &mut f, &plan, (eye, camera), stats);
         Ok((f, plan))
     }
 
@@ -76,7 +77,7 @@ impl Dcs {
         p: &Prepared,
         f: &mut Frame,
         plan: &Plan,
-        eye: Vec3,
+        (eye, camera): (Vec3, &shadow_core::raster::RasterView),
         stats: &mut Stats,
     ) {
         let c = p.shape.center;
@@ -87,7 +88,7 @@ impl Dcs {
             f.bits = self.forced_bits.unwrap_or_else(|| width_for(0));
             return;
         }
-        let (origins, centred, view) = (&f.origins, &f.centred, f.view);
+        let (origins, centred) = (&f.origins, &f.centred);
         let (constants, quads) = stats.time("shadow-volumes", || {
             let eye_c = eye_constant(p.scene.as_ref(), p.units, eye, c);
             integration_constants(
@@ -96,7 +97,7 @@ impl Dcs {
                 c,
                 eye,
                 eye_c,
-                view.raster_view(),
+                camera,
                 origins,
                 centred,
                 &f.active,
@@ -276,7 +277,7 @@ impl Dcs {
                     } else {
                         &scratch.samples
                     };
-                    let albedo = p.scene.albedo_at(s.triangle as usize, s.position);
+                    let albedo = s.albedo_in(p.scene.as_ref());
                     let vis = &scratch.vis;
                     out.push((i, pixel_direct(s, albedo, light, samples, |k| vis[k])));
                 },
@@ -360,7 +361,7 @@ impl Dcs {
             .unzip();
         let offset = RayOffset::for_light(&*light);
         let p = Prepared {
-            rays: self.rays.map(|_| RayPath::default()),
+            rays: self.rays.as_ref().map(|_| RayPath::default()),
             planar,
             rect,
             scan,

@@ -42,6 +42,7 @@ use shadow_core::direct::pixel_direct;
 use shadow_core::light::{LightGeometry, LightKind, LightSample};
 use shadow_core::offset::RayOffset;
 use shadow_core::prelude::*;
+use shadow_core::rays::{PreparedRays, RayScratch, ShadowRays};
 use shadow_core::technique::{Capabilities, Processor, SceneRef};
 use shadow_core::view_samples::ViewSample;
 use shadow_core::visibility::{PerSampleVisibility, PixelClass};
@@ -130,9 +131,9 @@ pub struct Dcs {
     /// Whether pixels of one shared sample set share its set-up ([`crate::accel::shared_sets`]);
     /// off only in tests, which check the shared set-up against each pixel's own.
     share_sets: bool,
-    /// Squares where rays are predicted to cost less go to the reference on the same samples
+    /// Frames where rays are predicted to cost less go to these shadow rays on the same samples
     /// ([`rays`]); `None`: DCS everywhere.
-    rays: Option<RayChoice>,
+    rays: Option<(RayChoice, Arc<dyn ShadowRays>)>,
 }
 
 /// DCS prepared for one scene and light: its edges, silhouettes, wedges and tables.
@@ -333,8 +334,8 @@ struct Scratch {
     visible: Vec<u64>,
     depth: Vec<u64>,
     vis: Vec<f32>,
-    /// The reference's buffers, for traced pixels.
-    rays: shadow_ref::PixelScratch,
+    /// The shadow rays' buffers, for traced pixels (made on the first one).
+    rays: Option<RayScratch>,
 }
 
 impl Scratch {
@@ -495,14 +496,15 @@ impl Dcs {
         self
     }
 
-    /// Traces with shadow rays, on the same samples, the squares where `choice` predicts rays
-    /// cost less than DCS ([`RayChoice`]): the same answers (up to numerical ties) for less
-    /// work on dense meshes under large lights. Opaque scenes only (on semi-opaque ones the
-    /// saturating opacity sum of section 3 is not what rays compute), and never when depth
-    /// complexities are asked for.
+    /// Traces with `tracer`'s shadow rays, on the same samples, the frames where `choice`
+    /// predicts rays cost less than DCS ([`RayChoice`]): the same answers (up to numerical
+    /// ties) for less work on dense meshes under large lights. Opaque scenes only (on
+    /// semi-opaque ones the saturating opacity sum of section 3 is not what rays compute), and
+    /// never when depth complexities are asked for. `shadow-ref`'s `BvhRays` is the tracer the
+    /// `dcs-*-hybrid` presets hand in; this crate does not depend on it.
     #[must_use]
-    pub fn with_rays(mut self, choice: RayChoice) -> Self {
-        self.rays = Some(choice);
+    pub fn with_rays(mut self, choice: RayChoice, tracer: Arc<dyn ShadowRays>) -> Self {
+        self.rays = Some((choice, tracer));
         self
     }
 
@@ -593,6 +595,9 @@ impl ShadowTechnique for Dcs {
             needs_closed_meshes: false,
             sample_based: true,
             processor: Processor::Cpu,
+            // The integration constant is counted over shadow-volume quads from the eye
+            // (section 4.1).
+            needs_camera: true,
         }
     }
 
@@ -604,7 +609,7 @@ impl ShadowTechnique for Dcs {
             "silhouettes": format!("{:?}", self.detection),
             "covered_samples": format!("{:?}", self.covered),
             // The hybrid's costs (in rays), so that a report says what the choice weighed.
-            "rays": self.rays.map(|c| json!({
+            "rays": self.rays.as_ref().map(|(c, _)| json!({
                 "rays_per_candidate": c.rays_per_candidate,
                 "per_further_word": c.per_further_word,
                 "rays_per_shadow_volume": c.rays_per_shadow_volume,
@@ -635,19 +640,20 @@ impl PreparedShadows for PreparedDcs {
         &self.stats
     }
 
-    fn estimate(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError> {
+    fn light(&self) -> &dyn AreaLight {
+        self.p.light.as_ref()
+    }
+
+    fn pass(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError> {
         let output = match self.config.output {
             PerSampleOutput::None if outputs.per_sample => PerSampleOutput::Bits,
             o => o,
         };
-        let mut est = self.config.run(&self.p, view, output)?;
-        if outputs.direct {
-            let t0 = std::time::Instant::now();
-            est.direct = Some(self.direct_illumination(view)?);
-            est.stats.add_time("direct", t0.elapsed().as_secs_f64());
-        }
-        est.darken_behind_light(view, self.p.light.as_ref());
-        Ok(est)
+        self.config.run(&self.p, view, output)
+    }
+
+    fn direct_light(&self, view: &ViewSamples, _: &Estimate) -> Result<Vec<Vec3>, TechniqueError> {
+        self.direct_illumination(view)
     }
 }
 
@@ -716,7 +722,7 @@ mod tests {
         };
         let mut lent = 0;
         for name in ["bunny", "contact", "spot-self-shadow", "large-light-close"] {
-            let setup = shadow_core::scenes::builtin(name).unwrap();
+            let setup = shadow_scenes::builtin(name).unwrap();
             let view =
                 ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 64, 48)
                     .unwrap();

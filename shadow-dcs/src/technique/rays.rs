@@ -5,9 +5,9 @@
 //! holds the view sample), which dense meshes under large lights make many times the light
 //! samples: on `grass` 7,800 pairs per per-sample pixel for 64 samples. A shadow ray's cost
 //! follows the logarithm of the triangles instead. Both answer the same question on the same
-//! light samples (the reference agrees with DCS sample by sample,
-//! [`shadow_ref::PreparedReference::pixel_visibility`]), so the choice changes the cost, never
-//! the answer.
+//! light samples (the rays are handed in through [`shadow_core::rays::ShadowRays`]; the
+//! reference's agree with DCS sample by sample), so the choice changes the cost, never the
+//! answer.
 //!
 //! The prediction reads what the box hierarchy knows before the scan: the (tile, wedge)
 //! candidates whose boxes meet, which the scan would evaluate on the tiles' view samples,
@@ -25,8 +25,6 @@
 //! `predicted-bvh-rays`).
 
 use std::sync::OnceLock;
-
-use shadow_ref::{PreparedReference, Reference};
 
 use super::*;
 use crate::accel::bins::{SquareScratch, square_tile_wedges};
@@ -85,24 +83,30 @@ const PROBE_WEDGES: usize = 256;
 /// Most squares of a frame whose candidates predict its DCS work (an evenly spaced sample).
 const PROBE_SQUARES: usize = 128;
 
-/// The shadow-ray side of a hybrid: the reference on DCS's own samples, built when first
-/// needed.
+/// The shadow-ray side of a hybrid: the caller's tracer prepared on DCS's scene and light,
+/// built when first needed.
 #[derive(Default)]
 pub(super) struct RayPath {
-    reference: OnceLock<Option<PreparedReference>>,
+    reference: OnceLock<Option<Box<dyn PreparedRays>>>,
 }
 
 impl RayPath {
-    /// The reference on `dcs`'s samples for `p`'s scene and light, built on the first call
-    /// (`None` when it cannot take them, which never happens for the scenes DCS takes).
-    fn get_or_build(&self, dcs: &Dcs, p: &Prepared) -> Option<&PreparedReference> {
+    /// `tracer` prepared for `p`'s scene and light on `dcs`'s samples, built on the first call
+    /// (`None` when it cannot take them, which never happens for the reference on the scenes
+    /// DCS takes).
+    fn get_or_build(
+        &self,
+        dcs: &Dcs,
+        tracer: &dyn ShadowRays,
+        p: &Prepared,
+    ) -> Option<&dyn PreparedRays> {
         self.reference
             .get_or_init(|| {
-                Reference::same_samples(dcs.sampler.clone())
-                    .prepare_reference(p.scene.clone(), p.light.clone())
+                tracer
+                    .prepare_rays(p.scene.clone(), p.light.clone(), &dcs.sampler)
                     .ok()
             })
-            .as_ref()
+            .as_deref()
     }
 }
 
@@ -119,7 +123,7 @@ pub(super) struct Plan<'p> {
     pub(super) block_wedges: u64,
     /// The reference, when the frame is traced (every square: then no pixel needs an
     /// integration constant).
-    pub(super) reference: Option<&'p PreparedReference>,
+    pub(super) reference: Option<&'p dyn PreparedRays>,
     /// The predicted work, in rays: DCS's squares, its shadow-volume pass, the rays of every
     /// active pixel, the BVH build (0 once built).
     pub(super) predicted: Option<[f64; 4]>,
@@ -140,9 +144,12 @@ impl Dcs {
             reference: None,
             predicted: None,
         };
-        let (Some(path), Some(choice), true, 1) = (&p.rays, self.rays, traceable, p.units) else {
+        let (Some(path), Some((choice, tracer)), true, 1) =
+            (&p.rays, self.rays.as_ref(), traceable, p.units)
+        else {
             return plan;
         };
+        let choice = *choice;
         let words = f64::from(self.sampler.count().div_ceil(64));
         let per_candidate = f64::from(choice.rays_per_candidate)
             * (1.0 + f64::from(choice.per_further_word) * (words - 1.0));
@@ -170,7 +177,7 @@ impl Dcs {
             / probed.len().max(1) as f64;
         plan.predicted = Some([dcs, volumes, rays, bvh]);
         if choice == RayChoice::EVERYWHERE || rays + bvh < dcs + volumes {
-            plan.reference = path.get_or_build(self, p);
+            plan.reference = path.get_or_build(self, tracer.as_ref(), p);
         }
         plan
     }
@@ -185,7 +192,7 @@ impl Dcs {
     pub(super) fn ray_pixel(
         &self,
         p: &Prepared,
-        reference: &PreparedReference,
+        reference: &dyn PreparedRays,
         f: &Frame,
         i: usize,
         s: &ViewSample,
@@ -203,7 +210,8 @@ impl Dcs {
         if light.is_textured() {
             light.radiances_into(&scratch.units, &mut scratch.radiances);
         }
-        let (vis, rays) = reference.pixel_visibility(s, &scratch.samples, &mut scratch.rays);
+        let buffers = scratch.rays.get_or_insert_with(|| reference.scratch());
+        let (vis, rays) = reference.pixel_visibility(s, &scratch.samples, buffers);
         counts.rays += rays;
         let mut tally = ClassTally::new();
         for (k, &v) in vis.iter().enumerate() {

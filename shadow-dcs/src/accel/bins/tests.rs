@@ -13,7 +13,7 @@ use shadow_core::prelude::*;
 /// boxes around its view samples, some of them empty.
 #[test]
 fn box_tests_agree_unrolled_and_not() {
-    let setup = shadow_core::scenes::builtin("bunny").unwrap();
+    let setup = shadow_scenes::builtin("bunny").unwrap();
     let scene = setup.scene.as_ref();
     let (w, h) = (64, 48);
     let view = ViewSamples::render(scene, &setup.camera_or_default(), w, h).unwrap();
@@ -208,7 +208,7 @@ fn box_tests_keep_the_boxes_a_plane_reaches() {
 #[test]
 fn the_hierarchy_finds_every_pair_of_the_brute_force_scan() {
     for (name, w, h) in [("bunny", 40, 30), ("overlapping-occluders", 70, 52)] {
-        let setup = shadow_core::scenes::builtin(name).unwrap();
+        let setup = shadow_scenes::builtin(name).unwrap();
         let scene = setup.scene.as_ref();
         let view = ViewSamples::render(scene, &setup.camera_or_default(), w, h).unwrap();
         let light = setup.lights[0].as_ref();

@@ -1,0 +1,385 @@
+//! Turning an emissive triangle mesh into an area light: planar meshes with one outline become
+//! rectangle, disk or polygon lights (rectangles and disks recognised exactly), a closed mesh
+//! whose vertices lie on a sphere becomes a sphere light, and any other shape (bent, with
+//! holes, in pieces, double-sided, or textured in a way the exact shapes cannot map) becomes a
+//! [`MeshLight`] (issue 52), which the reference and `ref-adaptive` render and the other
+//! techniques refuse by name. Only a mesh with no area at all is an error.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use glam::{Affine2, DVec3, Mat2, Vec2, Vec3};
+use shadow_core::geometry::{Aabb, triangle_cross_f64};
+
+use super::LoadError;
+use shadow_core::light::{
+    DiskLight, Light, LightError, MeshLight, PolygonLight, Radiance, RectLight, SphereLight,
+    TexturedRadiance,
+};
+
+/// An emissive texture with the mesh's texture coordinates (per input vertex).
+#[derive(Debug, Clone)]
+pub struct EmissiveTexture {
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Linear RGB texels, row 0 at texture v = 0.
+    pub texels: Vec<Vec3>,
+    /// Texture coordinates per input vertex.
+    pub texcoords: Vec<Vec2>,
+}
+
+enum Shape {
+    Rect(RectLight),
+    Disk(DiskLight),
+    Polygon(PolygonLight),
+    Sphere(SphereLight),
+}
+
+/// Builds the light an emissive mesh describes (positions in world space).
+///
+/// # Errors
+/// [`LoadError::Unsupported`] for a mesh without area and a texture without texture
+/// coordinates; [`LoadError::Light`] when the light is invalid (a negative radiance).
+pub fn light_from_emissive_mesh(
+    name: &str,
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    emission: Vec3,
+    texture: Option<EmissiveTexture>,
+) -> Result<Light, LoadError> {
+    let unsupported = |reason: &str| LoadError::Unsupported {
+        mesh: name.to_string(),
+        reason: reason.to_string(),
+    };
+    let light_err = light_error(name);
+    if triangles.is_empty() {
+        return Err(unsupported("emissive mesh has no triangles"));
+    }
+    let constant = Radiance::constant(emission).map_err(light_err)?;
+    // Weld exactly equal positions.
+    let mut ids: HashMap<[u32; 3], u32> = HashMap::new();
+    let mut welded: Vec<Vec3> = Vec::new();
+    let remap: Vec<u32> = positions
+        .iter()
+        .map(|p| {
+            let next = welded.len() as u32;
+            *ids.entry(p.to_array().map(f32::to_bits))
+                .or_insert_with(|| {
+                    welded.push(*p);
+                    next
+                })
+        })
+        .collect();
+    let tris: Vec<[u32; 3]> = triangles
+        .iter()
+        .map(|t| t.map(|v| remap[v as usize]))
+        .collect();
+    let diag = Aabb::from_points(&welded).diagonal() as f64;
+    let mut n = DVec3::ZERO;
+    let mut abs_area = 0.0;
+    for t in &tris {
+        let c = triangle_cross_f64(
+            welded[t[0] as usize],
+            welded[t[1] as usize],
+            welded[t[2] as usize],
+        );
+        n += c;
+        abs_area += c.length();
+    }
+    let centroid = welded.iter().fold(DVec3::ZERO, |a, p| a + p.as_dvec3()) / welded.len() as f64;
+    let boundary = boundary_loops(&tris);
+    let planar = n.length() > 0.999 * abs_area && {
+        let nn = n.normalize();
+        welded
+            .iter()
+            .all(|p| (p.as_dvec3() - centroid).dot(nn).abs() <= 1e-4 * diag)
+    };
+    if !(abs_area > 0.0) {
+        return Err(unsupported(
+            "emissive mesh has no area: every triangle is degenerate",
+        ));
+    }
+    let as_mesh = |texture| mesh_light(name, positions, triangles, emission, texture);
+    let shape = if planar {
+        let normal = n.normalize().as_vec3();
+        let outline = match boundary {
+            Ok(loops) if loops.len() == 1 => simplify(
+                &loops[0]
+                    .iter()
+                    .map(|&v| welded[v as usize])
+                    .collect::<Vec<_>>(),
+            ),
+            // Holes, several pieces, a boundary touching itself: any shape is a mesh light.
+            _ => return as_mesh(texture),
+        };
+        match planar_shape(&outline, normal, constant.clone()) {
+            Ok(shape) => shape,
+            Err(LightError::InvalidPolygon(_)) => return as_mesh(texture),
+            Err(e) => return Err(light_err(e)),
+        }
+    } else {
+        let closed = matches!(&boundary, Ok(l) if l.is_empty());
+        let dists: Vec<f64> = welded
+            .iter()
+            .map(|p| (p.as_dvec3() - centroid).length())
+            .collect();
+        let r = dists.iter().sum::<f64>() / dists.len() as f64;
+        // A plane through the largest triangle, to tell a flat mesh whose faces cancel
+        // (double-sided, or wound both ways) from one that is not flat at all.
+        let largest = tris.iter().max_by(|a, b| {
+            let area = |t: &&[u32; 3]| {
+                triangle_cross_f64(
+                    welded[t[0] as usize],
+                    welded[t[1] as usize],
+                    welded[t[2] as usize],
+                )
+                .length()
+            };
+            area(a).total_cmp(&area(b))
+        });
+        let flat_both_ways = largest.is_some_and(|t| {
+            let c = triangle_cross_f64(
+                welded[t[0] as usize],
+                welded[t[1] as usize],
+                welded[t[2] as usize],
+            );
+            c.length() > 0.0 && {
+                let nn = c.normalize();
+                let o = welded[t[0] as usize].as_dvec3();
+                welded
+                    .iter()
+                    .all(|p| (p.as_dvec3() - o).dot(nn).abs() <= 1e-4 * diag)
+            }
+        });
+        if !flat_both_ways
+            && texture.is_none()
+            && closed
+            && welded.len() >= 6
+            && dists.iter().all(|d| (d - r).abs() <= 2e-3 * r)
+        {
+            Shape::Sphere(
+                SphereLight::new(centroid.as_vec3(), r as f32, constant.clone())
+                    .map_err(light_err)?,
+            )
+        } else {
+            // Bent, or flat with triangles facing both ways (a double-sided card emits from
+            // both sides, each triangle from its front).
+            return as_mesh(texture);
+        }
+    };
+    let radiance = match texture {
+        None => constant,
+        Some(tex) => {
+            let uv_of = |p: Vec3| -> Result<Vec2, LoadError> {
+                match &shape {
+                    Shape::Rect(l) => Ok(l.uv_of(p)),
+                    Shape::Disk(l) => Ok(l.uv_of(p)),
+                    Shape::Polygon(l) => Ok(l.uv_of(p)),
+                    Shape::Sphere(_) => unreachable!("textured emitters are never spheres"),
+                }
+            };
+            if tex.texcoords.len() != positions.len() {
+                return Err(unsupported("emissive texture without texture coordinates"));
+            }
+            let light_uv = positions
+                .iter()
+                .map(|p| uv_of(*p))
+                .collect::<Result<Vec<_>, _>>()?;
+            let Some(map) = fit_affine(triangles, &light_uv, &tex.texcoords) else {
+                // Not one affine map over the exact shape: each triangle keeps its own.
+                return as_mesh(Some(tex));
+            };
+            Radiance::Textured(
+                TexturedRadiance::new(tex.width, tex.height, tex.texels, emission, map)
+                    .map_err(light_err)?,
+            )
+        }
+    };
+    let light: Light = match shape {
+        Shape::Rect(l) => Arc::new(l.with_radiance(radiance)),
+        Shape::Disk(l) => Arc::new(l.with_radiance(radiance)),
+        Shape::Polygon(l) => Arc::new(l.with_radiance(radiance)),
+        Shape::Sphere(l) => Arc::new(l),
+    };
+    Ok(light)
+}
+
+/// The emissive mesh as a [`MeshLight`]: every triangle of area, in its winding, with its
+/// texture coordinates when the emission is a texture.
+fn mesh_light(
+    name: &str,
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    emission: Vec3,
+    texture: Option<EmissiveTexture>,
+) -> Result<Light, LoadError> {
+    let light_err = light_error(name);
+    let tris: Vec<[Vec3; 3]> = triangles
+        .iter()
+        .map(|t| t.map(|v| positions[v as usize]))
+        .collect();
+    let light = match texture {
+        None => MeshLight::new(
+            &tris,
+            None,
+            Radiance::constant(emission).map_err(light_err)?,
+        ),
+        Some(tex) => {
+            if tex.texcoords.len() != positions.len() {
+                return Err(LoadError::Unsupported {
+                    mesh: name.to_string(),
+                    reason: "emissive texture without texture coordinates".into(),
+                });
+            }
+            let tc: Vec<[Vec2; 3]> = triangles
+                .iter()
+                .map(|t| t.map(|v| tex.texcoords[v as usize]))
+                .collect();
+            let radiance = Radiance::Textured(
+                TexturedRadiance::new(
+                    tex.width,
+                    tex.height,
+                    tex.texels,
+                    emission,
+                    Affine2::IDENTITY,
+                )
+                .map_err(light_err)?,
+            );
+            MeshLight::new(&tris, Some(&tc), radiance)
+        }
+    }
+    .map_err(light_err)?;
+    Ok(Arc::new(light))
+}
+
+/// The error of an invalid light made from mesh `name`.
+fn light_error(name: &str) -> impl Fn(LightError) -> LoadError + Copy + '_ {
+    move |source| LoadError::Light {
+        mesh: name.to_string(),
+        source,
+    }
+}
+
+/// Directed boundary loops (edges used by exactly one triangle), following the winding.
+fn boundary_loops(tris: &[[u32; 3]]) -> Result<Vec<Vec<u32>>, String> {
+    let mut count: HashMap<(u32, u32), i32> = HashMap::new();
+    for t in tris {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    let mut next: HashMap<u32, u32> = HashMap::new();
+    for t in tris {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            match count[&(a.min(b), a.max(b))] {
+                1 => {
+                    if next.insert(a, b).is_some() {
+                        return Err("boundary touches itself at a vertex".into());
+                    }
+                }
+                2 => {}
+                _ => return Err("non-manifold edge in an emissive mesh".into()),
+            }
+        }
+    }
+    let mut loops = Vec::new();
+    let mut starts: Vec<u32> = next.keys().copied().collect();
+    starts.sort_unstable();
+    let mut used = std::collections::HashSet::new();
+    for s in starts {
+        if used.contains(&s) {
+            continue;
+        }
+        let mut lp = vec![s];
+        used.insert(s);
+        let mut v = s;
+        loop {
+            let Some(&w) = next.get(&v) else {
+                return Err("open boundary chain".into());
+            };
+            if w == s {
+                break;
+            }
+            if !used.insert(w) || lp.len() > next.len() {
+                return Err("boundary is not a simple loop".into());
+            }
+            lp.push(w);
+            v = w;
+        }
+        loops.push(lp);
+    }
+    Ok(loops)
+}
+
+/// Removes vertices where the outline goes straight on.
+fn simplify(outline: &[Vec3]) -> Vec<Vec3> {
+    let n = outline.len();
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        let (p, c, q) = (outline[(i + n - 1) % n], outline[i], outline[(i + 1) % n]);
+        let (a, b) = ((c - p).as_dvec3(), (q - c).as_dvec3());
+        if a.cross(b).length() > 1e-6 * a.length() * b.length() {
+            out.push(c);
+        }
+    }
+    out
+}
+
+fn planar_shape(outline: &[Vec3], normal: Vec3, radiance: Radiance) -> Result<Shape, LightError> {
+    let n = outline.len();
+    if n == 4 {
+        let e: Vec<Vec3> = (0..4).map(|i| outline[(i + 1) % 4] - outline[i]).collect();
+        let right = (0..4).all(|i| {
+            e[i].dot(e[(i + 1) % 4]).abs() <= 1e-4 * e[i].length() * e[(i + 1) % 4].length()
+        });
+        if right {
+            // Start at a corner so that edge 0 and edge 3 (reversed) span the rectangle with
+            // u x v along the winding normal.
+            let c0 = outline[0];
+            let (u, v) = (0.5 * e[0], -0.5 * e[3]);
+            let (u, v) = if u.cross(v).dot(normal) >= 0.0 {
+                (u, v)
+            } else {
+                (v, u)
+            };
+            let center = c0 + u + v;
+            return RectLight::new(center, u, v, radiance).map(Shape::Rect);
+        }
+    }
+    let c = outline.iter().fold(Vec3::ZERO, |a, p| a + *p) / n as f32;
+    let d: Vec<f32> = outline.iter().map(|p| (*p - c).length()).collect();
+    let r = d.iter().sum::<f32>() / n as f32;
+    if n >= 8 && d.iter().all(|x| (x - r).abs() <= 1e-3 * r) {
+        return DiskLight::new(c, normal, r, radiance).map(Shape::Disk);
+    }
+    PolygonLight::new(outline.to_vec(), radiance).map(Shape::Polygon)
+}
+
+/// Fits `texcoord = M * light_uv + t` on the largest triangle and checks every vertex.
+fn fit_affine(triangles: &[[u32; 3]], luv: &[Vec2], tc: &[Vec2]) -> Option<Affine2> {
+    let best = triangles.iter().max_by(|a, b| {
+        let area = |t: &[u32; 3]| {
+            (luv[t[1] as usize] - luv[t[0] as usize])
+                .perp_dot(luv[t[2] as usize] - luv[t[0] as usize])
+                .abs()
+        };
+        area(a).total_cmp(&area(b))
+    })?;
+    let [a, b, c] = best.map(|v| v as usize);
+    let l = Mat2::from_cols(luv[b] - luv[a], luv[c] - luv[a]);
+    if l.determinant().abs() < 1e-12 {
+        return None;
+    }
+    let t = Mat2::from_cols(tc[b] - tc[a], tc[c] - tc[a]);
+    let m = t * l.inverse();
+    let map = Affine2::from_mat2_translation(m, tc[a] - m * luv[a]);
+    let ok = luv
+        .iter()
+        .zip(tc)
+        .all(|(l, t)| (map.transform_point2(*l) - *t).length() <= 1e-3 * (1.0 + t.length()));
+    (ok && map.is_finite()).then_some(map)
+}
