@@ -770,11 +770,9 @@ impl PreparedShadows for PreparedAfsm {
 
     fn check_outputs(&self, outputs: Outputs) -> Result<(), TechniqueError> {
         if outputs.direct && self.config.light_sampler().is_none() {
-            return Err(TechniqueError::unsupported(
+            return Err(TechniqueError::no_direct_light(
                 &self.config.name,
-                UnsupportedReason::Configuration(
-                    "hard shadows have no light samples to shade direct light from".into(),
-                ),
+                "hard shadows",
             ));
         }
         Ok(())
@@ -789,14 +787,10 @@ impl PreparedShadows for PreparedAfsm {
         view: &ViewSamples,
         est: &Estimate,
     ) -> Result<Vec<Vec3>, TechniqueError> {
-        let sampler = self.config.light_sampler().ok_or_else(|| {
-            TechniqueError::unsupported(
-                &self.config.name,
-                UnsupportedReason::Configuration(
-                    "hard shadows have no light samples to shade direct light from".into(),
-                ),
-            )
-        })?;
+        let sampler = self
+            .config
+            .light_sampler()
+            .ok_or_else(|| TechniqueError::no_direct_light(&self.config.name, "hard shadows"))?;
         shadow_core::technique::direct_from_per_sample(
             self.p.scene.as_ref(),
             self.p.light.as_ref(),

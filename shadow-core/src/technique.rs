@@ -111,6 +111,17 @@ impl TechniqueError {
         }
     }
 
+    /// [`TechniqueError::Unsupported`] for direct light asked of a technique without light
+    /// samples; `what` names what it has instead (`hard shadows`, `shadow-map filters`).
+    pub fn no_direct_light(technique: &str, what: &str) -> Self {
+        Self::unsupported(
+            technique,
+            UnsupportedReason::Configuration(format!(
+                "{what} have no light samples to shade direct light from"
+            )),
+        )
+    }
+
     /// The reason, when the technique does not support the input.
     pub fn unsupported_reason(&self) -> Option<&UnsupportedReason> {
         match self {

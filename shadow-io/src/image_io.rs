@@ -27,6 +27,58 @@ pub enum ImageError {
     /// Buffer sizes differ.
     #[error("image sizes differ")]
     Size,
+    /// A file could not be read as a float RGBA image.
+    #[error("reading {path}: {reason}")]
+    Read {
+        /// Source.
+        path: String,
+        /// Why.
+        reason: String,
+    },
+}
+
+/// A per-pixel RGB quantity read back from a float EXR of the layout this module writes (A is
+/// the validity): `(width, height, values, valid)`, row-major.
+pub type Aov = (u32, u32, Vec<Vec3>, Vec<bool>);
+
+/// Reads a float RGBA EXR as an [`Aov`]: any renderer's G-buffer in the layout
+/// [`write_position_exr`] and [`write_normal_exr`] write (alpha above one half is a valid
+/// pixel). At most `max_pixels` pixels are decoded.
+///
+/// # Errors
+/// [`ImageError::Read`] for a file that is missing, is not an image, is larger than
+/// `max_pixels`, or holds a non-finite value in a valid pixel.
+pub fn read_aov_exr(path: &Path, max_pixels: u64) -> Result<Aov, ImageError> {
+    let err = |reason: String| ImageError::Read {
+        path: path.display().to_string(),
+        reason,
+    };
+    let reader = image::ImageReader::open(path)
+        .map_err(|e| err(e.to_string()))?
+        .with_guessed_format()
+        .map_err(|e| err(e.to_string()))?;
+    let (w, h) = reader.into_dimensions().map_err(|e| err(e.to_string()))?;
+    if u64::from(w) * u64::from(h) > max_pixels {
+        return Err(err(format!(
+            "{w}x{h} pixels, above the limit of {max_pixels}"
+        )));
+    }
+    let img = image::open(path)
+        .map_err(|e| err(e.to_string()))?
+        .to_rgba32f();
+    let mut values = Vec::with_capacity((w * h) as usize);
+    let mut valid = Vec::with_capacity((w * h) as usize);
+    for (i, p) in img.pixels().enumerate() {
+        let [r, g, b, a] = p.0;
+        let ok = a > 0.5;
+        let v = Vec3::new(r, g, b);
+        if ok && !v.is_finite() {
+            return Err(err(format!("pixel {i} holds a non-finite value")));
+        }
+        values.push(if ok { v } else { Vec3::ZERO });
+        valid.push(ok);
+    }
+    Ok((w, h, values, valid))
 }
 
 fn save_rgba32(

@@ -50,6 +50,14 @@ fn foreign_gbuffer(setup: &SceneSetup, view: &ViewSamples) -> ViewSamples {
     .unwrap()
 }
 
+/// The positions and geometric normals of `view`'s receivers `order`.
+fn points_of(view: &ViewSamples, order: &[usize]) -> (Vec<Vec3>, Vec<Vec3>) {
+    (
+        order.iter().map(|&i| view.positions()[i]).collect(),
+        order.iter().map(|&i| view.geometric_normals()[i]).collect(),
+    )
+}
+
 fn values(v: &VisibilityImage) -> Vec<f32> {
     (0..(v.width() * v.height()) as usize)
         .map(|i| if v.is_valid(i) { v.value(i) } else { -1.0 })
@@ -133,11 +141,7 @@ fn shuffled_points_without_a_camera_are_answered_in_the_callers_order() {
         let mut receivers: Vec<usize> = (0..view.len()).filter(|&i| view.is_valid(i)).collect();
         // A fixed shuffle: the caller's order is not the image's.
         receivers.sort_by_key(|&i| (i as u64).wrapping_mul(0x2545_F491_4F6C_DD1D));
-        let positions: Vec<Vec3> = receivers.iter().map(|&i| view.positions()[i]).collect();
-        let normals: Vec<Vec3> = receivers
-            .iter()
-            .map(|&i| view.geometric_normals()[i])
-            .collect();
+        let (positions, normals) = points_of(&view, &receivers);
         let snapping = Snapping::for_scene(setup.scene.as_ref());
         let points =
             ViewSamples::from_points(setup.scene.as_ref(), &positions, &normals, snapping).unwrap();
@@ -296,11 +300,7 @@ fn bad_receivers_are_typed_errors_naming_the_receiver() {
 fn techniques_that_need_a_camera_refuse_points_with_a_typed_reason() {
     let (setup, view) = scene_and_view("bunny");
     let receivers: Vec<usize> = (0..view.len()).filter(|&i| view.is_valid(i)).collect();
-    let positions: Vec<Vec3> = receivers.iter().map(|&i| view.positions()[i]).collect();
-    let normals: Vec<Vec3> = receivers
-        .iter()
-        .map(|&i| view.geometric_normals()[i])
-        .collect();
+    let (positions, normals) = points_of(&view, &receivers);
     let points = ViewSamples::from_points(
         setup.scene.as_ref(),
         &positions,

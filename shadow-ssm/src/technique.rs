@@ -420,11 +420,9 @@ impl PreparedShadows for PreparedFilter {
 
     fn check_outputs(&self, outputs: Outputs) -> Result<(), TechniqueError> {
         if outputs.direct {
-            return Err(TechniqueError::unsupported(
+            return Err(TechniqueError::no_direct_light(
                 &self.config.name,
-                UnsupportedReason::Configuration(
-                    "shadow-map filters have no light samples to shade direct light from".into(),
-                ),
+                "shadow-map filters",
             ));
         }
         Ok(())

@@ -77,6 +77,13 @@ pub struct RenderArgs {
     /// `direct-ratio.exr` and `direct-ratio.png`.
     #[arg(long)]
     direct: bool,
+    /// Receivers from another renderer instead of the built-in rasterizer: a folder holding
+    /// `position.exr` and `normal.exr` (float RGBA, alpha = valid pixel; the layout `render`
+    /// itself writes). They are snapped onto the scene. They carry no camera, so techniques
+    /// that work in the camera's image (DCS, `ssm-adaptive`) refuse them unless `--camera`
+    /// names the camera they were rendered with.
+    #[arg(long)]
+    gbuffer: Option<PathBuf>,
     /// Output directory.
     #[arg(long)]
     out: PathBuf,
@@ -95,6 +102,49 @@ const OUTPUTS: [&str; 10] = [
     "direct-ratio.exr",
     "direct-ratio.png",
 ];
+
+/// The receivers of a foreign G-buffer in `dir` (`position.exr`, `normal.exr`), in the scene's
+/// coordinates (`shift` subtracted where the scene was recentred), with `camera` when the
+/// caller named the one they were rendered with.
+fn foreign_gbuffer(
+    dir: &std::path::Path,
+    setup: &SceneSetup,
+    camera: Option<&Camera>,
+    shift: Vec3,
+) -> Result<ViewSamples, String> {
+    use shadow_core::receivers::{GBuffer, Snapping};
+    use shadow_core::view_samples::MAX_VIEW_PIXELS;
+    use shadow_io::image_io::read_aov_exr;
+    let read =
+        |name: &str| read_aov_exr(&dir.join(name), MAX_VIEW_PIXELS).map_err(|e| e.to_string());
+    let (w, h, positions, valid) = read("position.exr")?;
+    let (nw, nh, normals, normal_valid) = read("normal.exr")?;
+    if (w, h) != (nw, nh) {
+        return Err(format!(
+            "{}: position.exr is {w}x{h}, normal.exr {nw}x{nh}",
+            dir.display()
+        ));
+    }
+    let positions: Vec<Vec3> = positions.iter().map(|p| *p - shift).collect();
+    let valid: Vec<bool> = valid
+        .iter()
+        .zip(&normal_valid)
+        .map(|(a, b)| *a && *b)
+        .collect();
+    let g = GBuffer {
+        width: w,
+        height: h,
+        positions: &positions,
+        geometric_normals: &normals,
+        shading_normals: None,
+        albedo: None,
+        valid: Some(&valid),
+        camera: camera.map(|c| c.raster_view(w, h)),
+    };
+    let scene = setup.scene.as_ref();
+    ViewSamples::from_gbuffer(scene, &g, Snapping::for_scene(scene))
+        .map_err(|e| format!("{}: {e}", dir.display()))
+}
 
 pub fn run(a: RenderArgs) -> Result<(), String> {
     let mut setup = resolve_scene(&a.scene, a.light.is_some(), a.emissive_as_geometry)?;
@@ -161,14 +211,18 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
     let pb = progress(if technique.is_some() { 4 } else { 2 }, "view samples");
     let camera = setup.camera_or_default();
     let t0 = Instant::now();
-    let view = ViewSamples::render(setup.scene.as_ref(), &camera, a.width, height)
-        .map_err(|e| e.to_string())?;
+    let view = match &a.gbuffer {
+        Some(dir) => foreign_gbuffer(dir, &setup, a.camera.is_some().then_some(&camera), shift)?,
+        None => ViewSamples::render(setup.scene.as_ref(), &camera, a.width, height)
+            .map_err(|e| e.to_string())?,
+    };
+    let (width, height) = (view.width(), view.height());
     let view_seconds = t0.elapsed().as_secs_f64();
     if view.valid_count() == 0 {
         return Err(format!(
             "the camera sees no surface of `{}` at {}x{height} (is the scene in front of the \
              camera and beyond its near plane?)",
-            setup.name, a.width
+            setup.name, width
         ));
     }
     pb.inc(1);
@@ -185,8 +239,10 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         "triangles": setup.scene.triangle_count(),
         "light": format!("{:?}", light.kind()),
         "light_index": light_index,
-        "width": a.width,
+        "width": width,
         "height": height,
+        "receivers": if a.gbuffer.is_some() { "gbuffer" } else { "camera" },
+        "unmatched_receivers": view.unmatched_receivers(),
         "valid_pixels": view.valid_count(),
         "seed": a.seed,
         "threads": rayon::current_num_threads(),
@@ -285,7 +341,7 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
     println!(
         "wrote {} ({}x{}, {} valid pixels)",
         a.out.display(),
-        a.width,
+        width,
         height,
         view.valid_count()
     );

@@ -720,3 +720,68 @@ fn punctual_lights_render_and_take_a_size() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("KHR_lights_punctual"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Issue 67: `render --gbuffer DIR` shadows another renderer's receivers (`position.exr` and
+/// `normal.exr`, alpha = valid) and answers as on its own view of the same surfaces.
+#[test]
+fn render_takes_a_foreign_gbuffer_and_answers_as_on_its_own_view() {
+    let own = temp_dir("gbuffer-own");
+    let foreign = temp_dir("gbuffer-foreign");
+    let run = |extra: &[&str], out: &std::path::Path| {
+        let mut args = vec!["render", "--scene", "bunny", "--technique", "ref-64"];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["--out", out.to_str().unwrap()]);
+        xtask(&args)
+    };
+    let out = run(&["--width", "48"], &own);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = run(&["--gbuffer", own.to_str().unwrap()], &foreign);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let a = image::open(own.join("visibility.exr"))
+        .unwrap()
+        .to_rgba32f();
+    let b = image::open(foreign.join("visibility.exr"))
+        .unwrap()
+        .to_rgba32f();
+    assert_eq!(a.dimensions(), b.dimensions());
+    let (mut sum, mut n) = (0.0f64, 0u32);
+    for (p, q) in a.pixels().zip(b.pixels()) {
+        assert_eq!(p.0[3], q.0[3], "the same pixels hold receivers");
+        if p.0[3] > 0.5 {
+            sum += f64::from((p.0[0] - q.0[0]).abs());
+            n += 1;
+        }
+    }
+    assert!(
+        n > 0 && sum / f64::from(n) < 2e-3,
+        "mean difference {}",
+        sum / f64::from(n)
+    );
+    // Without the camera they were rendered with, DCS cannot count its shadow volumes.
+    let refused = temp_dir("gbuffer-dcs");
+    let out = xtask(&[
+        "render",
+        "--scene",
+        "bunny",
+        "--technique",
+        "dcs-64",
+        "--gbuffer",
+        own.to_str().unwrap(),
+        "--out",
+        refused.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("camera"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
