@@ -787,16 +787,9 @@ impl PreparedShadows for PreparedAfsm {
         view: &ViewSamples,
         est: &Estimate,
     ) -> Result<Vec<Vec3>, TechniqueError> {
-        let sampler = self
-            .config
-            .light_sampler()
-            .ok_or_else(|| TechniqueError::no_direct_light(&self.config.name, "hard shadows"))?;
-        shadow_core::technique::direct_from_per_sample(
-            self.p.scene.as_ref(),
-            self.p.light.as_ref(),
-            sampler,
-            view,
-            &est.visibility,
-        )
+        let no_samples = || TechniqueError::no_direct_light(&self.config.name, "hard shadows");
+        let sampler = self.config.light_sampler().ok_or_else(no_samples)?;
+        let (scene, light) = (self.p.scene.as_ref(), self.p.light.as_ref());
+        shadow_core::technique::direct_from_per_sample(scene, light, sampler, view, &est.visibility)
     }
 }

@@ -589,59 +589,6 @@ fn listed_variance(probe: &[Acc], i: usize, list: &[u32]) -> f64 {
     if n == 0 { 0.0 } else { sum / f64::from(n) }
 }
 
-/// The progressive-set size of every pixel with variance `c_i` (0 where nothing is sampled):
-/// `n_i = K c_i^(2/5)` within `[B, largest]`, `K` such that the modelled image MSE
-/// `sum c_i (n_i / B)^-3/2 / pixels` is `target^2`, each count rounded to the nearest of
-/// `schedule` in log scale.
-fn allocate(vars: &[f64], pixels: usize, target: f64, schedule: &[u32]) -> Vec<u32> {
-    let b = f64::from(schedule[0]);
-    let largest = f64::from(*schedule.last().expect("the schedule is not empty"));
-    // (c, c^(2/5)) of the pixels that plan at all, computed once: the bisection below
-    // evaluates the modelled error some sixty times.
-    let planned: Vec<(f64, f64)> = vars
-        .iter()
-        .filter(|&&c| c > 0.0)
-        .map(|&c| (c, c.powf(0.4)))
-        .collect();
-    let mse = |k: f64| {
-        planned
-            .iter()
-            .map(|&(c, a)| {
-                let x = (k * a).clamp(b, largest) / b;
-                c / (x * x.sqrt())
-            })
-            .sum::<f64>()
-            / pixels.max(1) as f64
-    };
-    let goal = target * target;
-    let (mut lo, mut hi) = (-60.0f64, 60.0f64);
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if mse(mid.exp()) > goal {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    let k = hi.exp();
-    vars.iter()
-        .map(|&c| {
-            if !(c > 0.0) {
-                return schedule[0];
-            }
-            let n = (k * c.powf(0.4)).clamp(b, largest).ln();
-            *schedule
-                .iter()
-                .min_by(|a, z| {
-                    (f64::from(**a).ln() - n)
-                        .abs()
-                        .total_cmp(&(f64::from(**z).ln() - n).abs())
-                })
-                .expect("the schedule is not empty")
-        })
-        .collect()
-}
-
 impl PreparedShadows for PreparedAdaptive {
     fn name(&self) -> &str {
         &self.config.name
@@ -740,7 +687,7 @@ impl PreparedAdaptive {
                 })
                 .collect();
             let target = f64::from(self.config.target);
-            let plan = allocate(&vars, view.valid_count(), target, schedule);
+            let plan = crate::allocation::allocate(&vars, view.valid_count(), target, schedule);
             let mut rows: Vec<(Vec<Acc>, Counts)> = (0..h)
                 .into_par_iter()
                 .map(|row| {

@@ -32,6 +32,7 @@
 #![deny(missing_docs)]
 
 pub mod adaptive;
+mod allocation;
 pub mod beam;
 pub mod bvh;
 pub mod offset;
