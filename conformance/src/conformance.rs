@@ -206,7 +206,13 @@ impl SceneContext {
             .map_err(Clone::clone)
     }
 
-    /// The light every case uses (the scene's first).
+    /// The size, samples, seed and receivers of this context.
+    pub fn config(&self) -> SuiteConfig {
+        self.config
+    }
+
+    /// The light every case's main checks use (the scene's first; a scene with several has
+    /// every light checked too, [`crate::lights`]).
     pub fn light(&self) -> Light {
         self.setup.lights[0].clone()
     }
@@ -304,6 +310,9 @@ pub struct CaseReport {
     pub seconds: f64,
     /// Wall time of the reference it was compared with, seconds.
     pub reference_seconds: f64,
+    /// On a scene with several lights, every light shadowed at once and compared
+    /// ([`crate::lights`]).
+    pub every_light: Option<crate::lights::EveryLight>,
     /// True when compared with the same-samples reference.
     pub same_samples: bool,
     /// The technique's output.
@@ -471,6 +480,8 @@ pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
         ),
         None => violations.push("the preset declares no budget for this scene".into()),
     }
+    let every_light =
+        crate::lights::check_every_light(preset, ctx, budget.as_ref(), &mut violations);
     let mut deterministic = None;
     let mut convergence = None;
     let checks = if cfg.extra_checks {
@@ -562,6 +573,7 @@ pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
         estimate_stats: est.stats,
         seconds,
         reference_seconds,
+        every_light,
         same_samples: same,
         estimate: est.visibility,
         reference,

@@ -26,4 +26,5 @@
 
 pub mod closed_form;
 pub mod conformance;
+pub mod lights;
 pub mod stress;

@@ -14,6 +14,7 @@
 //!   [`ShadowTechnique`] trait with its [`Stats`] and [`TechniqueError`].
 //! * [`direct`] and [`irradiance`]: direct illumination from per-sample visibility (DCS eq. 6)
 //!   and the closed-form unshadowed irradiance of planar lights.
+//! * [`lights`]: every light of a scene, V per light and direct light summed.
 //! * [`receivers`]: receivers handed in by the caller (a renderer's G-buffer, or points with
 //!   normals), snapped onto the scene.
 //! * [`rays`]: the shadow-ray traits a hybrid technique takes its rays through, so that no
@@ -64,6 +65,7 @@ pub mod gpu;
 mod gpu_timestamps;
 pub mod irradiance;
 pub mod light;
+pub mod lights;
 pub mod offset;
 pub mod raster;
 pub mod rays;
@@ -93,6 +95,7 @@ pub mod prelude {
         AreaLight, DiskLight, Light, LightKind, LightSample, PointLight, PolygonLight, Radiance,
         RectLight, SphereLight,
     };
+    pub use crate::lights::{LightEstimate, LightsEstimate, PreparedLights};
     pub use crate::sampling::{LightSampler, SamplingStrategy};
     pub use crate::scene::{MeshDesc, Scene, SceneBuilder, TriangleScene};
     pub use crate::technique::{

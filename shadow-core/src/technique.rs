@@ -94,6 +94,14 @@ pub enum TechniqueError {
     /// A GPU device or resource problem.
     #[error("device: {0}")]
     Device(String),
+    /// One light of several failed or was refused ([`crate::lights::PreparedLights`]).
+    #[error("light {index}: {error}")]
+    Light {
+        /// The light's index in the caller's list.
+        index: usize,
+        /// What went wrong with it.
+        error: Box<TechniqueError>,
+    },
 }
 
 impl From<crate::sampling::SamplingError> for TechniqueError {
@@ -122,10 +130,20 @@ impl TechniqueError {
         )
     }
 
-    /// The reason, when the technique does not support the input.
+    /// `error` as the error of light `index` of several.
+    pub fn for_light(index: usize, error: TechniqueError) -> Self {
+        Self::Light {
+            index,
+            error: Box::new(error),
+        }
+    }
+
+    /// The reason, when the technique does not support the input (for one light of several,
+    /// that light's reason).
     pub fn unsupported_reason(&self) -> Option<&UnsupportedReason> {
         match self {
             Self::Unsupported { reason, .. } => Some(reason),
+            Self::Light { error, .. } => error.unsupported_reason(),
             _ => None,
         }
     }
@@ -454,6 +472,19 @@ pub trait ShadowTechnique: Send + Sync {
         scene: SceneRef,
         light: Light,
     ) -> Result<Box<dyn PreparedShadows>, TechniqueError>;
+    /// [`ShadowTechnique::prepare`] for each of `lights` in `scene`, in order
+    /// ([`crate::lights::PreparedLights`]). A technique overrides it to build what the lights
+    /// share once (the reference builds one BVH for all of them).
+    fn prepare_each(
+        &self,
+        scene: SceneRef,
+        lights: &[Light],
+    ) -> Vec<Result<Box<dyn PreparedShadows>, TechniqueError>> {
+        lights
+            .iter()
+            .map(|l| self.prepare(scene.clone(), l.clone()))
+            .collect()
+    }
 }
 
 /// A technique prepared for one scene and light.

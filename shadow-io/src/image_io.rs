@@ -277,7 +277,7 @@ pub fn write_error_png(
     })
 }
 
-/// Writes a shaded view ([`shaded_image`]) as a PNG.
+/// Writes a shaded view under every light ([`shaded_image_lights`]) as a PNG.
 ///
 /// # Errors
 /// [`ImageError`] on size mismatch or write failure.
@@ -285,10 +285,9 @@ pub fn write_shaded_png(
     path: &Path,
     scene: &dyn Scene,
     view: &ViewSamples,
-    light: &dyn AreaLight,
-    v: &dyn VisibilityBuffer,
+    lights: &[(&dyn AreaLight, &dyn VisibilityBuffer)],
 ) -> Result<(), ImageError> {
-    save_png(path, &shaded_image(scene, view, light, v)?)
+    save_png(path, &shaded_image_lights(scene, view, lights)?)
 }
 
 /// A shaded view in 8-bit sRGB: albedo x V x cos(shading normal, direction to the light
@@ -303,27 +302,57 @@ pub fn shaded_image(
     light: &dyn AreaLight,
     v: &dyn VisibilityBuffer,
 ) -> Result<RgbImage, ImageError> {
-    if v.width() != view.width() || v.height() != view.height() {
+    shaded_image_lights(scene, view, &[(light, v)])
+}
+
+/// [`shaded_image`] under several lights, each with its own V: their terms summed, each
+/// light's mean radiance normalised to the largest channel of the brightest light.
+///
+/// # Errors
+/// [`ImageError::Size`] when a buffer and `view` differ in size.
+pub fn shaded_image_lights(
+    scene: &dyn Scene,
+    view: &ViewSamples,
+    lights: &[(&dyn AreaLight, &dyn VisibilityBuffer)],
+) -> Result<RgbImage, ImageError> {
+    if lights
+        .iter()
+        .any(|(_, v)| v.width() != view.width() || v.height() != view.height())
+    {
         return Err(ImageError::Size);
     }
-    let tint = {
-        let m = light.radiance().mean();
-        if m.max_element() > 0.0 {
-            m / m.max_element()
-        } else {
-            Vec3::ONE
-        }
-    };
+    let brightest = lights
+        .iter()
+        .map(|(l, _)| l.radiance().mean().max_element())
+        .fold(0.0f32, f32::max);
+    let tints: Vec<Vec3> = lights
+        .iter()
+        .map(|(l, _)| {
+            if brightest > 0.0 {
+                l.radiance().mean() / brightest
+            } else {
+                Vec3::ONE
+            }
+        })
+        .collect();
     Ok(rgb8(view.width(), view.height(), |i| match view.get(i) {
         Some(s) => {
-            let l = (light.center() - s.position).normalize_or_zero();
-            let cos = s.shading_normal.dot(l).max(0.0);
-            let vis = if v.is_rgb() {
-                v.rgb(i)
-            } else {
-                Vec3::splat(v.value(i)) * tint
-            };
-            s.albedo_in(scene) * vis * cos + Vec3::splat(0.02)
+            let albedo = s.albedo_in(scene);
+            let lit: Vec3 = lights
+                .iter()
+                .zip(&tints)
+                .map(|((light, v), tint)| {
+                    let l = (light.center() - s.position).normalize_or_zero();
+                    let cos = s.shading_normal.dot(l).max(0.0);
+                    let vis = if v.is_rgb() {
+                        v.rgb(i)
+                    } else {
+                        Vec3::splat(v.value(i)) * *tint
+                    };
+                    vis * cos
+                })
+                .sum();
+            albedo * lit + Vec3::splat(0.02)
         }
         None => BACKGROUND,
     }))

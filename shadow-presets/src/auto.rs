@@ -50,6 +50,10 @@ const AUTO_01: &[(&str, [f64; 5])] = &[
     // --test conformance -- points/auto`, 2026-12-07).
     ("bunny@points", [0.0090, 0.0250, 0.0001, 0.099, 0.0000]),
     ("interior@points", [0.0096, 0.0323, 0.0002, 0.119, 0.0003]),
+    // `interior`'s light 1, the disk pendant, shadowed with the scene's other lights: a small
+    // light where the chooser's cheaper pick lands near its target (`cargo xtask conformance
+    // --scenes interior --quick`, 2026-12-07).
+    ("interior#1", [0.0094, 0.0536, 0.0001, 0.177, 0.0020]),
 ];
 
 const AUTO_003: &[(&str, [f64; 5])] = &[
@@ -74,6 +78,7 @@ const AUTO_003: &[(&str, [f64; 5])] = &[
     ("corpus", [0.0031, 0.0201, 0.0001, 0.068, 0.0000]),
     ("bunny@points", [0.0026, 0.0072, -0.0000, 0.037, 0.0000]),
     ("interior@points", [0.0026, 0.0088, -0.0000, 0.068, 0.0000]),
+    ("interior#1", [0.0033, 0.0189, -0.0000, 0.058, 0.0000]),
 ];
 
 /// The chooser's presets.

@@ -236,6 +236,18 @@ impl Reference {
     ) -> Result<PreparedReference, TechniqueError> {
         let mut stats = Stats::default();
         let bvh = stats.time("bvh-build", || OcclusionBvh::build(scene.as_ref()));
+        self.prepare_on(Arc::new(bvh), scene, light, stats)
+    }
+
+    /// Everything per light on a BVH already built for `scene`; `stats` holds the BVH's cost
+    /// (or that it was shared).
+    fn prepare_on(
+        &self,
+        bvh: Arc<OcclusionBvh>,
+        scene: SceneRef,
+        light: Light,
+        mut stats: Stats,
+    ) -> Result<PreparedReference, TechniqueError> {
         stats.add("triangles", scene.triangle_count() as u64);
         let light: Light = if light.area() == 0.0 {
             Arc::new(
@@ -257,7 +269,7 @@ impl Reference {
             semi_opaque: scene.has_semi_opaque(),
             scene,
             light,
-            bvh: Arc::new(bvh),
+            bvh,
             offset,
         };
         Ok(PreparedReference {
@@ -510,6 +522,34 @@ impl ShadowTechnique for Reference {
         light: Light,
     ) -> Result<Box<dyn PreparedShadows>, TechniqueError> {
         Ok(Box::new(self.prepare_reference(scene, light)?))
+    }
+
+    /// One BVH for every light: the first light's preparation builds it, the others share it
+    /// (`bvh-shared`).
+    fn prepare_each(
+        &self,
+        scene: SceneRef,
+        lights: &[Light],
+    ) -> Vec<Result<Box<dyn PreparedShadows>, TechniqueError>> {
+        let mut shared: Option<Arc<OcclusionBvh>> = None;
+        lights
+            .iter()
+            .map(|light| {
+                let prepared = match &shared {
+                    Some(bvh) => {
+                        let mut stats = Stats::default();
+                        stats.add("bvh-shared", 1);
+                        self.prepare_on(bvh.clone(), scene.clone(), light.clone(), stats)?
+                    }
+                    None => {
+                        let p = self.prepare_reference(scene.clone(), light.clone())?;
+                        shared = Some(p.p.bvh.clone());
+                        p
+                    }
+                };
+                Ok(Box::new(prepared) as Box<dyn PreparedShadows>)
+            })
+            .collect()
     }
 }
 

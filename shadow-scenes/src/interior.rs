@@ -2,10 +2,13 @@
 //! window-sized light in a wall), issue 48: a large light over many occluders at every depth,
 //! receivers all around the light (walls up to the ceiling, the ceiling itself behind the
 //! light's plane), thin table and chair legs, shelves of books and a scanned mesh (Spot) on the
-//! table. Every mesh is closed, the room's shell facing inward.
+//! table. Every mesh is closed, the room's shell facing inward. `interior` has two more lights
+//! ([`lamps`]): the multi-light interior (issue 67).
 
 use glam::{Affine3A, Vec3};
-use shadow_core::light::RectLight;
+use std::sync::Arc;
+
+use shadow_core::light::{DiskLight, Light, Radiance, RectLight, SphereLight};
 use shadow_core::scene::MeshDesc;
 
 use super::{BuiltinError, Parts, SPOT_OBJ, cam, mesh, placed_obj, white};
@@ -116,6 +119,24 @@ pub(super) fn ceiling_panel() -> Result<Parts, BuiltinError> {
         0.6,
         white(1.0),
     )?)
+}
+
+/// The lights `interior` has besides its ceiling panel (issue 67): a warm disk pendant 0.15 m
+/// in radius hanging 1.7 m above the floor over the sofa, facing down, and a bare bulb (a sphere
+/// 0.08 m in radius) 1.9 m high between the table and the shelves. With the panel, three lights
+/// of three shapes: the multi-light interior of the conformance suite.
+pub(super) fn lamps() -> Result<Vec<Light>, BuiltinError> {
+    let warm = Radiance::constant(Vec3::new(3.0, 2.4, 1.6))?;
+    let cool = Radiance::constant(Vec3::new(1.6, 1.8, 2.0))?;
+    Ok(vec![
+        Arc::new(DiskLight::new(
+            Vec3::new(1.5, 1.7, 1.3),
+            Vec3::NEG_Y,
+            0.15,
+            warm,
+        )?),
+        Arc::new(SphereLight::new(Vec3::new(-0.6, 1.9, -1.3), 0.08, cool)?),
+    ])
 }
 
 /// `interior-window`: a 1.0 m wide, 1.2 m high light 1 cm in front of the left wall (x =

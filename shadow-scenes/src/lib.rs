@@ -21,7 +21,7 @@
 //! | `cornell-box` | an open five-wall room, the light recessed in a ceiling fixture, two spheres: receivers level with and behind the light, walls touching its fixture |
 //! | `spot-lamp` | a glTF file's `KHR_lights_punctual` spot light (a disk of radius 0.25 m) over a table on legs and a ball, loaded like a user's file |
 //! | `mesh-light` | a folded lamp (a mesh light, its two faces emitting from their undersides) over a box and a sphere: receivers that see one face, both or none |
-//! | `interior` | a furnished room (table, chairs, shelves of books, a sofa, Spot on the table; 7.4k triangles) under a 1.2 x 0.6 m ceiling panel: a large light over many occluders, walls up to the light's plane |
+//! | `interior` | a furnished room (table, chairs, shelves of books, a sofa, Spot on the table; 7.4k triangles) under a 1.2 x 0.6 m ceiling panel (light 0): a large light over many occluders, walls up to the light's plane; a disk pendant over the sofa (light 1) and a bare sphere bulb by the shelves (light 2) make it the multi-light interior |
 //! | `interior-window` | the same room lit by a window-sized light in a wall: receivers level with the light and behind it |
 
 pub mod corpus;
@@ -363,7 +363,11 @@ pub fn builtin(name: &str) -> Result<SceneSetup, BuiltinError> {
             });
         }
     };
-    finish(name, parts)
+    let mut setup = finish(name, parts)?;
+    if name == "interior" {
+        setup.lights.extend(interior::lamps()?);
+    }
+    Ok(setup)
 }
 
 /// The lamp of `mesh-light` (issue 52), exposed for checks against its faces as separate

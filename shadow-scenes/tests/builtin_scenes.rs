@@ -5,11 +5,31 @@ use shadow_core::light::LightKind;
 use shadow_core::prelude::*;
 use shadow_scenes::{BUILTIN_SCENES, builtin, transformed};
 
+/// `interior` is the multi-light interior: three lights of three shapes, none inside the
+/// furniture or the room's shell (every light sample sees some receiver).
+#[test]
+fn interior_has_three_lights_of_three_shapes() {
+    let s = builtin("interior").unwrap();
+    let kinds: Vec<LightKind> = s.lights.iter().map(|l| l.kind()).collect();
+    assert_eq!(
+        kinds,
+        [LightKind::Rectangle, LightKind::Disk, LightKind::Sphere]
+    );
+    let view = ViewSamples::render(s.scene.as_ref(), &s.camera.unwrap(), 64, 48).unwrap();
+    for (i, l) in s.lights.iter().enumerate() {
+        assert!(
+            shadow_core::lights::reaches_any_receiver(l, &view),
+            "light {i} reaches no receiver"
+        );
+    }
+}
+
 #[test]
 fn every_builtin_scene_renders_view_samples() {
     for name in BUILTIN_SCENES {
         let s = builtin(name).unwrap();
-        assert_eq!(s.lights.len(), 1, "{name}");
+        let lights = if name == "interior" { 3 } else { 1 };
+        assert_eq!(s.lights.len(), lights, "{name}");
         let cam = s.camera.unwrap();
         let view = ViewSamples::render(s.scene.as_ref(), &cam, 64, 48).unwrap();
         assert!(

@@ -13,6 +13,7 @@ use shadow_conformance::conformance::{
     BUDGET_RESOLUTION, Outcome, ReceiverMode, SceneContext, SuiteConfig, reference_curve,
     reference_time_at, run_case,
 };
+use shadow_conformance::lights::EveryLight;
 use shadow_io::image_io::{shaded_image, write_error_png, write_visibility_png};
 use shadow_metrics::compare;
 use shadow_scenes::{BUILTIN_SCENES, builtin};
@@ -93,6 +94,43 @@ fn conformance_scenes(named: &[String], corpus: bool) -> Vec<String> {
 /// Reference sample counts of the equal-error speed-up curve.
 const CURVE: [u32; 6] = [1, 4, 16, 64, 256, 1024];
 
+/// The report's table of multi-light scenes: each light's RMSE (with who shadowed it where the
+/// preset refused it) and the summed direct light's relative RMSE, per preset.
+fn every_light_section(md: &mut String, cases: &[(&str, String, EveryLight)]) {
+    if cases.is_empty() {
+        return;
+    }
+    writeln!(md, "\n## Every light\n\nScenes with several lights: every light shadowed at once; each light's V against the reference's for that light (RMSE; `->` names the fallback where the preset refused the light), and the direct light summed over the lights against the reference's from the same samples (relative RMSE, and its bound).\n\n| technique | scene | lights (RMSE) | summed direct |\n|---|---|---|---|").ok();
+    for (technique, scene, e) in cases {
+        let lights: Vec<String> = e
+            .lights
+            .iter()
+            .map(|l| {
+                let by = if l.fallback_because.is_some() {
+                    format!(" -> {}", l.technique)
+                } else {
+                    String::new()
+                };
+                let skipped = if l.skipped { " skipped" } else { "" };
+                format!(
+                    "{} {:?}{by}{skipped} {:.4}",
+                    l.index, l.kind, l.metrics.rmse
+                )
+            })
+            .collect();
+        let direct = match (e.direct_relative_rmse, e.direct_tolerance) {
+            (Some(r), Some(t)) => format!("{r:.4} (bound {t:.4})"),
+            _ => "-".into(),
+        };
+        writeln!(
+            md,
+            "| {technique} | {scene} | {} | {direct} |",
+            lights.join(", ")
+        )
+        .ok();
+    }
+}
+
 pub fn run(a: ConformanceArgs) -> Result<(), String> {
     let presets = shadow_presets::registry();
     for t in &a.techniques {
@@ -154,6 +192,7 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
         "speed-up"
     );
     let mut html_scenes = Vec::new();
+    let mut every_light = Vec::new();
     for scene in &scenes {
         pb.set_message(format!("{scene}: reference"));
         let ctx = SceneContext::new(builtin(scene).map_err(|e| e.to_string())?, cfg)?;
@@ -307,6 +346,9 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
                         .collect();
                     println!("{}", line.join(" "));
                     writeln!(md, "| {} |", cells.join(" | ")).ok();
+                    if let Some(e) = &r.every_light {
+                        every_light.push((p.name, scene.clone(), e.clone()));
+                    }
                     let mut row = serde_json::to_value(&*r).map_err(|e| e.to_string())?;
                     row["status"] = json!(if r.passed() { "ok" } else { "fail" });
                     row["rmse_against_independent_reference"] = json!(independent_rmse);
@@ -334,6 +376,7 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
         html_scenes.push(html_scene);
     }
     pb.finish_and_clear();
+    every_light_section(&mut md, &every_light);
     writeln!(md, "\nImages per case in `<scene>/<technique>/`: `visibility.png`, `error.png` (signed error, blue = too dark, red = too bright, full scale 0.5), `shaded.png` and `flip.png` (FLIP's error map, magma); the reference in `<scene>/reference.png`. All of them, the table and a time-error plot per scene in `report.html`.").ok();
     html::write_report(
         &a.out.join("report.html"),

@@ -43,10 +43,14 @@ pub struct RenderArgs {
     /// Image height (default: from the camera's aspect ratio, else 3/4 of the width).
     #[arg(long)]
     height: Option<u32>,
-    /// Which of the scene's lights to shadow (0-based, in file order); a scene with several
-    /// lights needs it.
+    /// Shadow only this one of the scene's lights (0-based, in file order); by default every
+    /// light is shadowed, V per light and direct light summed.
     #[arg(long)]
     light_index: Option<usize>,
+    /// A preset that traces the lights `--technique` refuses (their kind, a texture), for
+    /// example `ref`; without it such a light is an error naming it.
+    #[arg(long)]
+    fallback: Option<String>,
     /// A light in place of the file's: `rect:CENTER:NORMAL:WIDTHxHEIGHT`,
     /// `disk:CENTER:NORMAL:RADIUS` or `sphere:CENTER:RADIUS` (points and directions `x,y,z`).
     #[arg(long)]
@@ -102,6 +106,25 @@ const OUTPUTS: [&str; 10] = [
     "direct-ratio.exr",
     "direct-ratio.png",
 ];
+
+/// Removes every file a render may write from `out` (the per-light `visibility-K.*` too).
+fn remove_outputs(out: &std::path::Path) -> Result<(), String> {
+    let per_light = |name: &str| {
+        name.strip_prefix("visibility-").is_some_and(|rest| {
+            let k = rest.trim_end_matches(".exr").trim_end_matches(".png");
+            !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit())
+        })
+    };
+    let entries = std::fs::read_dir(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().to_string();
+        if OUTPUTS.contains(&name.as_str()) || per_light(&name) {
+            let f = entry.path();
+            std::fs::remove_file(&f).map_err(|e| format!("removing {}: {e}", f.display()))?;
+        }
+    }
+    Ok(())
+}
 
 /// The receivers of a foreign G-buffer in `dir` (`position.exr`, `normal.exr`), in the scene's
 /// coordinates (`shift` subtracted where the scene was recentred), with `camera` when the
@@ -194,20 +217,18 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         setup = moved;
         shift = by;
     }
-    let light_index = choose_light(&setup, a.light_index)?;
-    let light = setup.lights[light_index].clone();
+    let light_indices = chosen_lights(&setup, a.light_index)?;
+    let lights: Vec<Light> = light_indices
+        .iter()
+        .map(|&i| setup.lights[i].clone())
+        .collect();
     let height = a.height.unwrap_or_else(|| match setup.aspect {
         Some(r) if r > 0.0 && r.is_finite() => ((a.width as f32 / r).round() as u32).max(1),
         _ => (a.width * 3 / 4).max(1),
     });
     ensure_dir(&a.out)?;
     // A failed run must not leave an older run's images beside its error.
-    for name in OUTPUTS {
-        let f = a.out.join(name);
-        if f.exists() {
-            std::fs::remove_file(&f).map_err(|e| format!("removing {}: {e}", f.display()))?;
-        }
-    }
+    remove_outputs(&a.out)?;
     let pb = progress(if technique.is_some() { 4 } else { 2 }, "view samples");
     let camera = setup.camera_or_default();
     let t0 = Instant::now();
@@ -237,8 +258,7 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
     let mut stats = json!({
         "scene": setup.name,
         "triangles": setup.scene.triangle_count(),
-        "light": format!("{:?}", light.kind()),
-        "light_index": light_index,
+        "light_index": a.light_index,
         "width": width,
         "height": height,
         "receivers": if a.gbuffer.is_some() { "gbuffer" } else { "camera" },
@@ -251,25 +271,36 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         "recentred_by": (shift != Vec3::ZERO).then(|| shift.to_array()),
         "machine": machine(),
     });
-    if let Some(t) = technique.as_ref() {
+    let fallback = match &a.fallback {
+        Some(f) if technique.is_some() => Some(resolve_technique(f, None, a.seed)?),
+        Some(_) => return Err("--fallback goes with --technique".into()),
+        None => None,
+    };
+    let shadowing = match technique.as_ref() {
+        Some(t) => Some((
+            t.as_ref(),
+            Outputs {
+                per_sample: a.direct && t.light_sampler().is_some(),
+                direct: a.direct,
+            },
+        )),
+        None => None,
+    };
+    if let Some((t, outputs)) = shadowing {
         pb.set_message(format!("{}: prepare", t.name()));
-        let prepared = t
-            .prepare(setup.scene.clone(), light.clone())
-            .map_err(|e| e.to_string())?;
+        let all = PreparedLights::prepare(t, fallback.as_deref(), setup.scene.clone(), &lights)
+            .map_err(|e| light_error(e, &light_indices))?;
         pb.inc(1);
         pb.set_message(format!("{}: estimate", t.name()));
-        let outputs = Outputs {
-            per_sample: a.direct && t.light_sampler().is_some(),
-            direct: a.direct,
-        };
-        let est = prepared
+        let est = all
             .estimate(&view, outputs)
-            .map_err(|e| e.to_string())?;
+            .map_err(|e| light_error(e, &light_indices))?;
         pb.inc(1);
+        write_lights(&a.out, &setup, &lights, &light_indices, &view, &est)?;
         if let Some(direct) = &est.direct {
             write_direct(&a.out, "direct", &view, direct)?;
             let ratio = match t.light_sampler() {
-                Some(sampler) => write_ratio(&a.out, &setup, &light, sampler, &view, &est)?,
+                Some(sampler) => write_ratio(&a.out, &setup, &lights, sampler, &view, &est)?,
                 None => false,
             };
             stats["direct_illumination"] = json!({
@@ -279,29 +310,19 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
                 "ratio_estimator": ratio,
             });
         }
-        write_visibility_exr(&a.out.join("visibility.exr"), &est.visibility)
-            .map_err(|e| e.to_string())?;
-        write_visibility_png(&a.out.join("visibility.png"), &est.visibility)
-            .map_err(|e| e.to_string())?;
-        write_shaded_png(
-            &a.out.join("shaded.png"),
-            setup.scene.as_ref(),
-            &view,
-            light.as_ref(),
-            &est.visibility,
-        )
-        .map_err(|e| e.to_string())?;
         stats["technique"] = json!(t.name());
         stats["parameters"] = t.parameters();
         stats["samples"] = t.light_sampler().map_or(json!(null), |s| json!(s.count()));
-        stats["prepare"] =
-            serde_json::to_value(prepared.preparation()).map_err(|e| e.to_string())?;
+        stats["prepare"] = serde_json::to_value(all.preparation()).map_err(|e| e.to_string())?;
         stats["estimate"] = serde_json::to_value(&est.stats).map_err(|e| e.to_string())?;
-        stats["classes"] = json!(est.visibility.class_counts());
-        if !est.decision.is_null() {
-            let mut d = est.decision.clone();
-            d["achieved_seconds"] = json!(est.stats.total_seconds());
-            stats["decision"] = d;
+        stats["lights"] = lights_json(&light_indices, &lights, &est);
+        if let [one] = est.lights.as_slice() {
+            stats["classes"] = json!(one.estimate.visibility.class_counts());
+            if !one.estimate.decision.is_null() {
+                let mut d = one.estimate.decision.clone();
+                d["achieved_seconds"] = json!(est.stats.total_seconds());
+                stats["decision"] = d;
+            }
         }
         if let Some(r) = rays_per_second_per_thread(&est.stats) {
             stats["occlusion_rays_per_second_per_thread"] = json!(r);
@@ -312,23 +333,24 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         let r = shadow_ref::Reference::stratified(a.samples.unwrap_or(256), a.seed)
             .map_err(|e| e.to_string())?;
         let t0 = Instant::now();
-        let prepared = r
-            .prepare(setup.scene.clone(), light.clone())
-            .map_err(|e| e.to_string())?;
-        let outputs = Outputs {
-            per_sample: true,
-            direct: true,
-        };
-        let est = prepared
-            .estimate(&view, outputs)
-            .map_err(|e| e.to_string())?;
+        let est = PreparedLights::prepare(&r, None, setup.scene.clone(), &lights)
+            .and_then(|all| {
+                all.estimate(
+                    &view,
+                    Outputs {
+                        per_sample: true,
+                        direct: true,
+                    },
+                )
+            })
+            .map_err(|e| light_error(e, &light_indices))?;
         let direct = est
             .direct
             .as_deref()
             .ok_or("the reference gave no direct light")?;
         write_direct(&a.out, "direct", &view, direct)?;
         let sampler = r.light_sampler().ok_or("the reference has no sampler")?;
-        let ratio = write_ratio(&a.out, &setup, &light, sampler, &view, &est)?;
+        let ratio = write_ratio(&a.out, &setup, &lights, sampler, &view, &est)?;
         stats["direct_illumination"] = json!({
             "technique": r.name(),
             "samples": a.samples.unwrap_or(256),
@@ -375,55 +397,116 @@ fn write_direct(
     write_radiance_png(&out.join(format!("{stem}.png")), view, direct).map_err(|e| e.to_string())
 }
 
-/// Writes the ratio estimator of the estimate's per-sample visibility as `direct-ratio.*`;
-/// `false` (and nothing written) for lights without a closed form.
+/// Writes the ratio estimator of each light's per-sample visibility, summed over the lights,
+/// as `direct-ratio.*`; `false` (and nothing written) when a light has no closed form.
 fn write_ratio(
     out: &std::path::Path,
     setup: &SceneSetup,
-    light: &Light,
+    lights: &[Light],
     sampler: &LightSampler,
     view: &ViewSamples,
-    est: &Estimate,
+    est: &LightsEstimate,
 ) -> Result<bool, String> {
-    let ratio = shadow_core::technique::ratio_direct_from_per_sample(
-        setup.scene.as_ref(),
-        light.as_ref(),
-        sampler,
-        view,
-        &est.visibility,
+    let mut sum = vec![Vec3::ZERO; view.len()];
+    for (light, each) in lights.iter().zip(&est.lights) {
+        let ratio = shadow_core::technique::ratio_direct_from_per_sample(
+            setup.scene.as_ref(),
+            light.as_ref(),
+            sampler,
+            view,
+            &each.estimate.visibility,
+        )
+        .map_err(|e| e.to_string())?;
+        let Some(r) = ratio else { return Ok(false) };
+        for (s, v) in sum.iter_mut().zip(r) {
+            *s += v;
+        }
+    }
+    write_direct(out, "direct-ratio", view, &sum).map(|()| true)
+}
+
+/// Writes V (`visibility.exr` and `.png`, or with several lights `visibility-K.*` for the
+/// scene's light K) and `shaded.png` under every light.
+fn write_lights(
+    out: &std::path::Path,
+    setup: &SceneSetup,
+    lights: &[Light],
+    indices: &[usize],
+    view: &ViewSamples,
+    est: &LightsEstimate,
+) -> Result<(), String> {
+    for (each, k) in est.lights.iter().zip(indices) {
+        let stem = if lights.len() == 1 {
+            "visibility".to_string()
+        } else {
+            format!("visibility-{k}")
+        };
+        let v = &each.estimate.visibility;
+        write_visibility_exr(&out.join(format!("{stem}.exr")), v).map_err(|e| e.to_string())?;
+        write_visibility_png(&out.join(format!("{stem}.png")), v).map_err(|e| e.to_string())?;
+    }
+    let pairs: Vec<(&dyn AreaLight, &dyn VisibilityBuffer)> = lights
+        .iter()
+        .zip(&est.lights)
+        .map(|(l, e)| (l.as_ref(), &e.estimate.visibility as &dyn VisibilityBuffer))
+        .collect();
+    write_shaded_png(&out.join("shaded.png"), setup.scene.as_ref(), view, &pairs)
+        .map_err(|e| e.to_string())
+}
+
+/// Each light in `stats.json`: its index in the scene, kind, who shadowed it, and why the
+/// fallback did or why it was skipped.
+fn lights_json(indices: &[usize], lights: &[Light], est: &LightsEstimate) -> serde_json::Value {
+    json!(
+        indices
+            .iter()
+            .zip(lights)
+            .zip(&est.lights)
+            .map(|((k, l), e)| json!({
+                "index": k,
+                "kind": format!("{:?}", l.kind()),
+                "technique": e.technique,
+                "fallback_because": e.fallback.as_ref().map(ToString::to_string),
+                "skipped": e.skipped,
+                "classes": e.estimate.visibility.class_counts(),
+            }))
+            .collect::<Vec<_>>()
     )
-    .map_err(|e| e.to_string())?;
-    match ratio {
-        Some(r) => write_direct(out, "direct-ratio", view, &r).map(|()| true),
-        None => Ok(false),
+}
+
+/// A light's error with the scene's index of the light (the list shadowed may be one light
+/// that `--light-index` chose), and the way out of a refusal.
+fn light_error(e: TechniqueError, indices: &[usize]) -> String {
+    match e {
+        TechniqueError::Light { index, error } => {
+            let k = indices.get(index).copied().unwrap_or(index);
+            let hint = if error.unsupported_reason().is_some() {
+                " (--fallback ref traces it, --light-index K shadows another light alone)"
+            } else {
+                ""
+            };
+            format!("light {k}: {error}{hint}")
+        }
+        e => e.to_string(),
     }
 }
 
-/// The light to shadow: `chosen`, or the only one; a scene with several lights and no choice is
-/// an error that lists them, never a silent pick of the first.
-fn choose_light(setup: &SceneSetup, chosen: Option<usize>) -> Result<usize, String> {
+/// The lights to shadow: `chosen` alone, or every light of the scene.
+fn chosen_lights(setup: &SceneSetup, chosen: Option<usize>) -> Result<Vec<usize>, String> {
     let n = setup.lights.len();
-    let list = || {
-        setup
-            .lights
-            .iter()
-            .enumerate()
-            .map(|(i, l)| format!("{i}: {:?} at {:.3}", l.kind(), l.center()))
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
     match chosen {
-        Some(k) if k < n => Ok(k),
+        Some(k) if k < n => Ok(vec![k]),
         Some(k) => Err(format!(
             "--light-index {k}: `{}` has {n} light(s) ({})",
             setup.name,
-            list()
+            setup
+                .lights
+                .iter()
+                .enumerate()
+                .map(|(i, l)| format!("{i}: {:?} at {:.3}", l.kind(), l.center()))
+                .collect::<Vec<_>>()
+                .join(", ")
         )),
-        None if n == 1 => Ok(0),
-        None => Err(format!(
-            "`{}` has {n} lights ({}); choose one with --light-index K",
-            setup.name,
-            list()
-        )),
+        None => Ok((0..n).collect()),
     }
 }

@@ -373,10 +373,10 @@ fn a_successful_gpu_render_prints_no_error_line() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// Issue 51, item 9: a second emissive mesh was ignored without a word; a scene with several
-/// lights is refused with a list of them unless `--light-index K` picks one.
+/// Issue 51, item 9: a second emissive mesh was ignored without a word. Issue 67: every
+/// light is shadowed (V per light as `visibility-K.*`), or `--light-index K` picks one.
 #[test]
-fn a_scene_with_several_lights_needs_a_choice() {
+fn a_scene_with_several_lights_shadows_each_or_the_one_chosen() {
     let dir = temp_dir("two-lights");
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("two.gltf");
@@ -402,24 +402,86 @@ fn a_scene_with_several_lights_needs_a_choice() {
         args.extend_from_slice(extra);
         xtask(&args)
     };
-    let out = run(&[]);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success());
+    let stats = || -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("stats.json")).unwrap()).unwrap()
+    };
+    let out = run(&["--direct"]);
     assert!(
-        err.contains("2 lights") && err.contains("--light-index"),
-        "{err}"
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
     );
+    for f in [
+        "visibility-0.exr",
+        "visibility-1.png",
+        "shaded.png",
+        "direct.exr",
+    ] {
+        assert!(out_dir.join(f).is_file(), "{f}");
+    }
+    assert!(!out_dir.join("visibility.exr").exists());
+    let s = stats();
+    assert_eq!(s["lights"].as_array().unwrap().len(), 2);
+    assert_eq!(s["estimate"]["counters"]["lights-shadowed"], 2);
     let out = run(&["--light-index", "1"]);
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let stats: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out_dir.join("stats.json")).unwrap())
-            .unwrap();
-    assert_eq!(stats["light_index"], 1);
+    assert_eq!(stats()["light_index"], 1);
+    // One light chosen: `visibility.exr`, and the earlier run's per-light files are gone.
+    assert!(out_dir.join("visibility.exr").is_file());
+    assert!(!out_dir.join("visibility-0.exr").exists());
     assert!(!run(&["--light-index", "2"]).status.success());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Issue 67: `interior`'s sphere bulb is outside the light kinds of DCS's tables; the refusal
+/// names the light, and `--fallback ref-16` traces it.
+#[test]
+fn a_refused_light_is_named_and_the_fallback_traces_it() {
+    let dir = temp_dir("fallback");
+    let d = dir.to_str().unwrap();
+    let args = [
+        "render",
+        "--scene",
+        "interior",
+        "--technique",
+        "dcs-64-interleaved",
+        "--width",
+        "24",
+        "--out",
+        d,
+    ];
+    let out = xtask(&args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("light 2") && err.contains("--fallback"),
+        "{err}"
+    );
+    let out = xtask(&[&args[..], &["--fallback", "ref-16"]].concat());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stats: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("stats.json")).unwrap()).unwrap();
+    let lights = stats["lights"].as_array().unwrap();
+    let who: Vec<&str> = lights
+        .iter()
+        .map(|l| l["technique"].as_str().unwrap())
+        .collect();
+    assert_eq!(who, ["dcs-64-interleaved", "dcs-64-interleaved", "ref-16"]);
+    assert!(
+        lights[2]["fallback_because"]
+            .as_str()
+            .unwrap()
+            .contains("sphere")
+    );
+    assert_eq!(stats["prepare"]["counters"]["lights-fallback"], 1);
     std::fs::remove_dir_all(&dir).ok();
 }
 
