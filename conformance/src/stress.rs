@@ -109,6 +109,7 @@ fn setup_of(name: &str, meshes: Vec<MeshDesc>, light: Light, camera: Camera) -> 
         aspect: None,
         warnings: vec![],
         punctual: vec![],
+        layouts: Vec::new(),
     }
 }
 

@@ -5,9 +5,11 @@
 use glam::{Affine3A, DVec3, Vec3};
 use thiserror::Error;
 
-use crate::albedo::{AlbedoMaps, TexturedAlbedo};
+use crate::albedo::AlbedoMaps;
 use crate::geometry::{Aabb, triangle_cross_f64, triangle_normal};
 use crate::topology::Topology;
+
+pub use crate::mesh::{MeshDesc, PerTriangle};
 
 /// The largest coordinate magnitude a scene may hold: two points within it are at most
 /// `3.5e18` apart, whose square (`1.2e37`) stays inside `f32`'s range, so bounds, ray lengths
@@ -230,6 +232,8 @@ impl TriangleScene {
             albedo: PerTriangle::Each(self.albedos.clone()),
             albedo_texture: None,
             transform: world_from_scene,
+            name: None,
+            texcoords: None,
         })?;
         // Degenerate triangles are rejected, so the triangles keep their order and the
         // textures theirs (a mirroring transform reverses every winding, corners and
@@ -276,74 +280,6 @@ impl Scene for TriangleScene {
     }
     fn has_semi_opaque(&self) -> bool {
         self.semi_opaque
-    }
-}
-
-/// A value given once for a whole mesh or once per triangle.
-#[derive(Debug, Clone, PartialEq)]
-pub enum PerTriangle<T> {
-    /// Same value for every triangle.
-    All(T),
-    /// One value per triangle.
-    Each(Vec<T>),
-}
-
-/// One mesh to add to a [`SceneBuilder`].
-#[derive(Debug, Clone)]
-pub struct MeshDesc {
-    /// Vertex positions in the mesh's own space.
-    pub positions: Vec<Vec3>,
-    /// Triangles (indices into `positions`).
-    pub triangles: Vec<[u32; 3]>,
-    /// Optional per-vertex shading normals in the mesh's own space.
-    pub normals: Option<Vec<Vec3>>,
-    /// Opacity in [0, 1].
-    pub opacity: PerTriangle<f32>,
-    /// Diffuse albedo in [0, 1].
-    pub albedo: PerTriangle<Vec3>,
-    /// A base-colour texture with per-vertex coordinates; it replaces `albedo` in shaded and
-    /// direct output ([`Scene::albedo_at`]).
-    pub albedo_texture: Option<TexturedAlbedo>,
-    /// World from mesh transform.
-    pub transform: Affine3A,
-}
-
-impl MeshDesc {
-    /// An opaque, grey mesh with identity transform and no shading normals.
-    pub fn new(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Self {
-        Self {
-            positions,
-            triangles,
-            normals: None,
-            opacity: PerTriangle::All(1.0),
-            albedo: PerTriangle::All(Vec3::splat(0.8)),
-            albedo_texture: None,
-            transform: Affine3A::IDENTITY,
-        }
-    }
-    /// Sets the opacity of every triangle.
-    #[must_use]
-    pub fn with_opacity(mut self, opacity: f32) -> Self {
-        self.opacity = PerTriangle::All(opacity);
-        self
-    }
-    /// Sets the albedo of every triangle.
-    #[must_use]
-    pub fn with_albedo(mut self, albedo: Vec3) -> Self {
-        self.albedo = PerTriangle::All(albedo);
-        self
-    }
-    /// Sets the world-from-mesh transform.
-    #[must_use]
-    pub fn with_transform(mut self, transform: Affine3A) -> Self {
-        self.transform = transform;
-        self
-    }
-    /// Sets per-vertex shading normals.
-    #[must_use]
-    pub fn with_normals(mut self, normals: Vec<Vec3>) -> Self {
-        self.normals = Some(normals);
-        self
     }
 }
 

@@ -1,4 +1,6 @@
-//! Issue 52 item 7: base-colour textures give the albedo of shaded and direct output.
+//! Issue 52 item 7: base-colour textures give the albedo of shaded and direct output. Issue 67:
+//! a mesh's `TEXCOORD_0` is its lightmap layout (`bake --mesh NAME`), in world space, one per
+//! node that shows the mesh.
 
 mod common;
 
@@ -80,4 +82,38 @@ fn a_base_colour_texture_colours_the_albedo() {
         )
     });
     assert!(reds > 20 && blues > 20, "{reds} {blues}");
+}
+
+#[test]
+fn texcoord_0_gives_each_node_of_a_mesh_its_layout() {
+    let mut w = Writer::default();
+    let grey = w.material(json!({"name": "grey"}));
+    let lamp = w.material(json!({"emissiveFactor": [1.0, 1.0, 1.0]}));
+    let (fp, fi) = square(2.0);
+    let up: Vec<u32> = fi.chunks(3).flat_map(|c| [c[0], c[2], c[1]]).collect();
+    let uv: Vec<Vec2> = fp
+        .iter()
+        .map(|p| Vec2::new((p.x + 2.0) / 4.0, (p.z + 2.0) / 4.0))
+        .collect();
+    w.mesh("floor", &fp, &up, Some(&uv), grey);
+    let (lp, li) = square(0.5);
+    w.mesh("lamp", &lp, &li, None, lamp);
+    let doc = w.document(
+        json!([
+            {"mesh": 0},
+            {"mesh": 0, "translation": [10.0, 0.0, 0.0]},
+            {"mesh": 1, "translation": [0.0, 3.0, 0.0]}
+        ]),
+        json!([]),
+    );
+    let setup = load(&doc).unwrap();
+    let names: Vec<&str> = setup.layouts.iter().map(|l| l.name.as_str()).collect();
+    assert_eq!(names, ["floor", "floor#1"]);
+    let moved = setup.layout("floor#1").unwrap();
+    assert_eq!(moved.texcoords, uv);
+    for (p, q) in moved.positions.iter().zip(&fp) {
+        assert!((*p - (*q + Vec3::new(10.0, 0.0, 0.0))).length() < 1e-5);
+    }
+    let e = setup.layout("lamp").unwrap_err();
+    assert!(e.contains("meshes with them: floor, floor#1"), "{e}");
 }

@@ -156,6 +156,7 @@ fn single_triangle_occluder_closed_form() {
         aspect: None,
         warnings: vec![],
         punctual: vec![],
+        layouts: vec![],
     };
     let cam = Camera::look_at(Vec3::new(0.0, 3.0, 3.0), Vec3::ZERO, Vec3::Y, 0.9).unwrap();
     let view = ViewSamples::render(setup.scene.as_ref(), &cam, 64, 48).unwrap();
@@ -223,6 +224,7 @@ fn unoccluded_direct_illumination_equals_the_form_factor() {
         aspect: None,
         warnings: vec![],
         punctual: vec![],
+        layouts: vec![],
     };
     let cam = Camera::look_at(Vec3::new(0.0, 3.0, 3.0), Vec3::ZERO, Vec3::Y, 0.9).unwrap();
     let view = ViewSamples::render(setup.scene.as_ref(), &cam, 48, 36).unwrap();
@@ -338,6 +340,7 @@ fn no_acne_on_flat_and_curved_receivers() {
             aspect: None,
             warnings: vec![],
             punctual: vec![],
+            layouts: vec![],
         };
         let cam = Camera::look_at(
             offset + Vec3::new(1.0, 2.0, 2.0) * scale,
@@ -506,6 +509,7 @@ fn semi_opaque_occluders_multiply_transmittances() {
         aspect: None,
         warnings: vec![],
         punctual: vec![],
+        layouts: vec![],
     };
     let cam = Camera::look_at(
         Vec3::new(0.0, 0.5, 0.0) + Vec3::new(0.0, -0.0, 0.0),

@@ -163,5 +163,6 @@ fn build(name: &str, mesh: &str, light: &str) -> Result<SceneSetup, LoadError> {
         aspect: None,
         warnings,
         punctual: Vec::new(),
+        layouts: Vec::new(),
     })
 }

@@ -32,6 +32,7 @@ use std::sync::Arc;
 
 use glam::{Affine2, Affine3A, Vec3};
 use shadow_core::camera::Camera;
+use shadow_core::lightmap::{LightmapError, UvLayout};
 use shadow_core::scene::{MeshDesc, SceneBuilder};
 use shadow_io::load::punctual::PunctualLight;
 use shadow_io::load::{LoadError, LoadLimits, SceneSetup};
@@ -109,6 +110,9 @@ pub enum BuiltinError {
     /// A light could not be built.
     #[error("building light: {0}")]
     Light(#[from] LightError),
+    /// A mesh's texture layout is invalid.
+    #[error("texture layout: {0}")]
+    Layout(#[from] LightmapError),
 }
 
 fn white(v: f32) -> Radiance {
@@ -125,8 +129,27 @@ fn mesh(m: Mesh) -> MeshDesc {
     MeshDesc::new(m.0, m.1)
 }
 
+/// A square floor of `side` at y = 0 named `floor`, its texture layout (`TEXCOORD_0`) the
+/// square itself: `u` along +x and `v` along +z, each from 0 to 1 (`bake --mesh floor`).
+fn floor_mesh(side: f32) -> MeshDesc {
+    let (positions, triangles) = floor(side, 0.0);
+    let uv = positions
+        .iter()
+        .map(|p| glam::Vec2::new(p.x / side + 0.5, p.z / side + 0.5))
+        .collect();
+    MeshDesc::new(positions, triangles)
+        .with_name("floor")
+        .with_texcoords(uv)
+}
+
 fn finish(name: &str, parts: Parts) -> Result<SceneSetup, BuiltinError> {
     let mut b = SceneBuilder::new();
+    let mut layouts = Vec::new();
+    for (i, m) in parts.meshes.iter().enumerate() {
+        if m.texcoords.is_some() {
+            layouts.push(UvLayout::of(m, &format!("mesh {i}"))?);
+        }
+    }
     for m in parts.meshes {
         b.push_mesh(m).map_err(LoadError::from)?;
     }
@@ -139,6 +162,7 @@ fn finish(name: &str, parts: Parts) -> Result<SceneSetup, BuiltinError> {
         aspect: None,
         warnings: Vec::new(),
         punctual: Vec::new(),
+        layouts,
     })
 }
 
@@ -186,7 +210,7 @@ pub fn builtin(name: &str) -> Result<SceneSetup, BuiltinError> {
     let parts = match name {
         "quad-over-plane" => Parts {
             meshes: vec![
-                mesh(floor(q::FLOOR_SIDE, 0.0)),
+                floor_mesh(q::FLOOR_SIDE),
                 mesh(quad(
                     Vec3::new(0.0, q::OCCLUDER_HEIGHT, 0.0),
                     Vec3::new(0.5 * q::OCCLUDER_SIDE, 0.0, 0.0),
@@ -202,7 +226,7 @@ pub fn builtin(name: &str) -> Result<SceneSetup, BuiltinError> {
         },
         "overlapping-occluders" => Parts {
             meshes: vec![
-                mesh(floor(6.0, 0.0)),
+                floor_mesh(6.0),
                 mesh(quad(
                     Vec3::new(-0.35, 1.3, 0.0),
                     Vec3::new(0.5, 0.0, 0.0),
@@ -224,7 +248,7 @@ pub fn builtin(name: &str) -> Result<SceneSetup, BuiltinError> {
         },
         "large-light-close" => Parts {
             meshes: vec![
-                mesh(floor(6.0, 0.0)),
+                floor_mesh(6.0),
                 mesh(cuboid(
                     Vec3::new(-0.3, 0.35, -0.3),
                     Vec3::new(0.3, 0.65, 0.3),
@@ -235,12 +259,12 @@ pub fn builtin(name: &str) -> Result<SceneSetup, BuiltinError> {
             camera: cam(Vec3::new(0.0, 2.6, 3.0), Vec3::new(0.0, 0.2, 0.0), 55.0),
         },
         "bunny" => Parts {
-            meshes: vec![mesh(floor(4.0, 0.0)), placed_obj(BUNNY_OBJ, 1.0, 0.0)?],
+            meshes: vec![floor_mesh(4.0), placed_obj(BUNNY_OBJ, 1.0, 0.0)?],
             light: Arc::new(down(Vec3::new(0.6, 2.5, 0.4), 0.8, white(1.0))?),
             camera: cam(Vec3::new(0.0, 1.4, 2.6), Vec3::new(0.0, 0.45, 0.0), 45.0),
         },
         "spot-self-shadow" => Parts {
-            meshes: vec![mesh(floor(4.0, 0.0)), placed_obj(SPOT_OBJ, 1.2, 0.6)?],
+            meshes: vec![floor_mesh(4.0), placed_obj(SPOT_OBJ, 1.2, 0.6)?],
             light: Arc::new(RectLight::facing(
                 Vec3::new(-1.6, 2.0, 0.9),
                 Vec3::new(1.6, -2.0, -0.9),
@@ -251,10 +275,7 @@ pub fn builtin(name: &str) -> Result<SceneSetup, BuiltinError> {
             camera: cam(Vec3::new(1.2, 1.3, 2.3), Vec3::new(0.0, 0.5, 0.0), 45.0),
         },
         "grass" => Parts {
-            meshes: vec![
-                mesh(floor(4.0, 0.0)),
-                mesh(grass(30_000, 0.75, 0.5, 0.05, 7)),
-            ],
+            meshes: vec![floor_mesh(4.0), mesh(grass(30_000, 0.75, 0.5, 0.05, 7))],
             light: Arc::new(RectLight::facing(
                 Vec3::new(-4.0, 1.1, 0.0),
                 Vec3::new(4.0, -1.1, 0.0),
@@ -266,7 +287,7 @@ pub fn builtin(name: &str) -> Result<SceneSetup, BuiltinError> {
         },
         "contact" => Parts {
             meshes: vec![
-                mesh(floor(6.0, 0.0)),
+                floor_mesh(6.0),
                 mesh(cuboid(
                     Vec3::new(-0.9, 0.0, -0.3),
                     Vec3::new(-0.3, 0.5, 0.3),
@@ -284,7 +305,7 @@ pub fn builtin(name: &str) -> Result<SceneSetup, BuiltinError> {
         },
         "semi-opaque" => Parts {
             meshes: vec![
-                mesh(floor(6.0, 0.0)),
+                floor_mesh(6.0),
                 mesh(quad(
                     Vec3::new(-0.4, 1.2, 0.0),
                     Vec3::new(0.45, 0.0, 0.0),
@@ -309,7 +330,7 @@ pub fn builtin(name: &str) -> Result<SceneSetup, BuiltinError> {
         },
         "textured-light" => Parts {
             meshes: vec![
-                mesh(floor(6.0, 0.0)),
+                floor_mesh(6.0),
                 mesh(cuboid(
                     Vec3::new(-0.25, 0.6, -0.25),
                     Vec3::new(0.25, 0.9, 0.25),
@@ -346,7 +367,7 @@ pub fn builtin(name: &str) -> Result<SceneSetup, BuiltinError> {
         "interior-window" => interior::window()?,
         "mesh-light" => Parts {
             meshes: vec![
-                mesh(floor(6.0, 0.0)),
+                floor_mesh(6.0),
                 mesh(cuboid(
                     Vec3::new(-0.3, 0.9, -0.3),
                     Vec3::new(0.3, 1.1, 0.3),
@@ -426,7 +447,7 @@ fn cornell_box() -> Result<Parts, BuiltinError> {
     let (h, hole, top) = (2.0f32, 0.25f32, 2.1f32);
     let rect = |c: Vec3, u: Vec3, v: Vec3| mesh(quad(c, u, v));
     let mut meshes = vec![
-        mesh(floor(2.0, 0.0)),
+        floor_mesh(2.0),
         // Back, left and right walls.
         rect(
             Vec3::new(0.0, 1.0, -1.0),
@@ -644,6 +665,18 @@ fn moved(
                 position: p.position * scale + translation,
                 radius: p.radius * scale,
                 ..p.clone()
+            })
+            .collect(),
+        layouts: setup
+            .layouts
+            .iter()
+            .map(|l| UvLayout {
+                positions: l
+                    .positions
+                    .iter()
+                    .map(|p| *p * scale + translation)
+                    .collect(),
+                ..l.clone()
             })
             .collect(),
     })

@@ -170,6 +170,7 @@ fn sphere_scene(rings: u32) -> SceneSetup {
         aspect: None,
         warnings: vec![],
         punctual: vec![],
+        layouts: Vec::new(),
     }
 }
 

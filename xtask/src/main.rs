@@ -2,6 +2,7 @@
 //!
 //! * `scenes`: list the built-in scenes.
 //! * `render`: view samples (and a technique's visibility) of a built-in scene or a file.
+//! * `bake`: a lightmap over a mesh's texture layout, from every light.
 //! * `conformance`: the main job, every preset on every supported built-in scene, with a report.
 //! * `bench`: run time against error, reference curves and scaling sweeps, CSV/JSON and plots.
 //! * `stress`: the numerical-stability suite against every preset.
@@ -9,6 +10,7 @@
 //!   estimator of direct light against eq. 6.
 
 mod auto_study;
+mod bake;
 mod bench;
 mod bench_summary;
 mod budgets;
@@ -40,6 +42,9 @@ enum Command {
     /// Render view samples (position.exr, normal.exr, stats.json) and, with a technique, its
     /// visibility (visibility.exr, visibility.png, shaded.png).
     Render(render::RenderArgs),
+    /// Bake a lightmap: the texels of a mesh's texture layout (TEXCOORD_0) shadowed from every
+    /// light (position.exr, normal.exr, visibility.exr, direct.exr with --direct).
+    Bake(bake::BakeArgs),
     /// Run every preset on every supported built-in scene against the reference.
     Conformance(conformance::ConformanceArgs),
     /// Benchmark run time against error; scaling sweeps; CSV, JSON and plots.
@@ -94,6 +99,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Scenes => common::list_scenes(),
         Command::Render(a) => render::run(a),
+        Command::Bake(a) => bake::run(a),
         Command::Conformance(a) => conformance::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Stress(a) => stress::run(a),

@@ -107,8 +107,25 @@ const OUTPUTS: [&str; 10] = [
     "direct-ratio.png",
 ];
 
+/// Writes the receivers' `position.exr` (in the file's coordinates: `shift` subtracted where
+/// the scene was recentred) and `normal.exr`.
+pub(crate) fn write_receivers(
+    out: &std::path::Path,
+    view: &ViewSamples,
+    shift: Vec3,
+) -> Result<(), String> {
+    let position = out.join("position.exr");
+    if shift == Vec3::ZERO {
+        write_position_exr(&position, view).map_err(|e| e.to_string())?;
+    } else {
+        let file: Vec<Vec3> = view.positions().iter().map(|p| *p - shift).collect();
+        write_rgb_exr(&position, view, &file).map_err(|e| e.to_string())?;
+    }
+    write_normal_exr(&out.join("normal.exr"), view).map_err(|e| e.to_string())
+}
+
 /// Removes every file a render may write from `out` (the per-light `visibility-K.*` too).
-fn remove_outputs(out: &std::path::Path) -> Result<(), String> {
+pub(crate) fn remove_outputs(out: &std::path::Path) -> Result<(), String> {
     let per_light = |name: &str| {
         name.strip_prefix("visibility-").is_some_and(|rest| {
             let k = rest.trim_end_matches(".exr").trim_end_matches(".png");
@@ -247,13 +264,7 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         ));
     }
     pb.inc(1);
-    if shift == Vec3::ZERO {
-        write_position_exr(&a.out.join("position.exr"), &view).map_err(|e| e.to_string())?;
-    } else {
-        let file: Vec<Vec3> = view.positions().iter().map(|p| *p - shift).collect();
-        write_rgb_exr(&a.out.join("position.exr"), &view, &file).map_err(|e| e.to_string())?;
-    }
-    write_normal_exr(&a.out.join("normal.exr"), &view).map_err(|e| e.to_string())?;
+    write_receivers(&a.out, &view, shift)?;
     pb.inc(1);
     let mut stats = json!({
         "scene": setup.name,
@@ -387,7 +398,7 @@ fn auto_technique(a: &RenderArgs) -> Result<Box<dyn ShadowTechnique>, String> {
 }
 
 /// Writes direct illumination as `STEM.exr` and `STEM.png` in `out`.
-fn write_direct(
+pub(crate) fn write_direct(
     out: &std::path::Path,
     stem: &str,
     view: &ViewSamples,
@@ -435,6 +446,24 @@ fn write_lights(
     view: &ViewSamples,
     est: &LightsEstimate,
 ) -> Result<(), String> {
+    write_visibilities(out, indices, est)?;
+    let pairs: Vec<(&dyn AreaLight, &dyn VisibilityBuffer)> = lights
+        .iter()
+        .zip(&est.lights)
+        .map(|(l, e)| (l.as_ref(), &e.estimate.visibility as &dyn VisibilityBuffer))
+        .collect();
+    write_shaded_png(&out.join("shaded.png"), setup.scene.as_ref(), view, &pairs)
+        .map_err(|e| e.to_string())
+}
+
+/// Writes V: `visibility.exr` and `.png` for one light, `visibility-K.*` for the scene's light
+/// K of several.
+pub(crate) fn write_visibilities(
+    out: &std::path::Path,
+    indices: &[usize],
+    est: &LightsEstimate,
+) -> Result<(), String> {
+    let lights = indices;
     for (each, k) in est.lights.iter().zip(indices) {
         let stem = if lights.len() == 1 {
             "visibility".to_string()
@@ -445,18 +474,16 @@ fn write_lights(
         write_visibility_exr(&out.join(format!("{stem}.exr")), v).map_err(|e| e.to_string())?;
         write_visibility_png(&out.join(format!("{stem}.png")), v).map_err(|e| e.to_string())?;
     }
-    let pairs: Vec<(&dyn AreaLight, &dyn VisibilityBuffer)> = lights
-        .iter()
-        .zip(&est.lights)
-        .map(|(l, e)| (l.as_ref(), &e.estimate.visibility as &dyn VisibilityBuffer))
-        .collect();
-    write_shaded_png(&out.join("shaded.png"), setup.scene.as_ref(), view, &pairs)
-        .map_err(|e| e.to_string())
+    Ok(())
 }
 
 /// Each light in `stats.json`: its index in the scene, kind, who shadowed it, and why the
 /// fallback did or why it was skipped.
-fn lights_json(indices: &[usize], lights: &[Light], est: &LightsEstimate) -> serde_json::Value {
+pub(crate) fn lights_json(
+    indices: &[usize],
+    lights: &[Light],
+    est: &LightsEstimate,
+) -> serde_json::Value {
     json!(
         indices
             .iter()
@@ -476,11 +503,15 @@ fn lights_json(indices: &[usize], lights: &[Light], est: &LightsEstimate) -> ser
 
 /// A light's error with the scene's index of the light (the list shadowed may be one light
 /// that `--light-index` chose), and the way out of a refusal.
-fn light_error(e: TechniqueError, indices: &[usize]) -> String {
+pub(crate) fn light_error(e: TechniqueError, indices: &[usize]) -> String {
     match e {
         TechniqueError::Light { index, error } => {
             let k = indices.get(index).copied().unwrap_or(index);
-            let hint = if error.unsupported_reason().is_some() {
+            let by_light = matches!(
+                error.unsupported_reason(),
+                Some(UnsupportedReason::Light { .. } | UnsupportedReason::TexturedLight)
+            );
+            let hint = if by_light {
                 " (--fallback ref traces it, --light-index K shadows another light alone)"
             } else {
                 ""
@@ -492,7 +523,10 @@ fn light_error(e: TechniqueError, indices: &[usize]) -> String {
 }
 
 /// The lights to shadow: `chosen` alone, or every light of the scene.
-fn chosen_lights(setup: &SceneSetup, chosen: Option<usize>) -> Result<Vec<usize>, String> {
+pub(crate) fn chosen_lights(
+    setup: &SceneSetup,
+    chosen: Option<usize>,
+) -> Result<Vec<usize>, String> {
     let n = setup.lights.len();
     match chosen {
         Some(k) if k < n => Ok(vec![k]),

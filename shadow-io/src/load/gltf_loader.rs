@@ -16,6 +16,7 @@ use gltf::{Document, Semantic};
 use shadow_core::albedo::{AlbedoTexture, TexturedAlbedo};
 use shadow_core::camera::Camera;
 use shadow_core::light::Light;
+use shadow_core::lightmap::UvLayout;
 use shadow_core::scene::{DegeneratePolicy, MeshDesc, PerTriangle, SceneBuilder};
 
 use super::emissive::{EmissiveTexture, light_from_emissive_mesh};
@@ -108,6 +109,7 @@ pub fn load_gltf_slice(
     let buffers = load_buffers(&doc, gltf.blob, base, limits)?;
     let mut builder = SceneBuilder::new().degenerate_policy(DegeneratePolicy::Drop);
     let mut lights: Vec<Light> = Vec::new();
+    let mut layouts: Vec<(usize, UvLayout)> = Vec::new();
     let mut camera = None;
     let mut aspect = None;
     let mut warnings = Vec::new();
@@ -400,6 +402,11 @@ pub fn load_gltf_slice(
                 desc.albedo = PerTriangle::All(factor);
                 desc.albedo_texture = albedo_texture;
                 desc.transform = Affine3A::from_mat4(world);
+                if let Some(acc) = prim.get(&Semantic::TexCoords(0)) {
+                    desc.texcoords = Some(read_vec2(&buffers, &acc, limits)?);
+                    desc.name = Some(mesh_name.clone());
+                    add_layout(&mut layouts, node.index(), &desc)?;
+                }
                 builder.push_mesh(desc)?;
                 occluders += 1;
             }
@@ -445,7 +452,36 @@ pub fn load_gltf_slice(
         aspect,
         warnings,
         punctual,
+        layouts: layouts.into_iter().map(|(_, l)| l).collect(),
     })
+}
+
+/// Adds the texture layout of `desc` (a primitive of node `node`) to `layouts`: the node's
+/// primitives make one layout, named after the mesh (`NAME#NODE` for a second node showing the
+/// same mesh).
+fn add_layout(
+    layouts: &mut Vec<(usize, UvLayout)>,
+    node: usize,
+    desc: &MeshDesc,
+) -> Result<(), LoadError> {
+    let mut layout =
+        UvLayout::of(desc, "unnamed").map_err(|e| LoadError::Accessor(e.to_string()))?;
+    if let Some((n, last)) = layouts.last_mut()
+        && *n == node
+        && last.name == layout.name
+    {
+        let offset = last.positions.len() as u32;
+        last.positions.extend(layout.positions);
+        last.texcoords.extend(layout.texcoords);
+        last.triangles
+            .extend(layout.triangles.iter().map(|t| t.map(|v| v + offset)));
+        return Ok(());
+    }
+    if layouts.iter().any(|(_, l)| l.name == layout.name) {
+        layout.name = format!("{}#{node}", layout.name);
+    }
+    layouts.push((node, layout));
+    Ok(())
 }
 
 fn assemble(mode: Mode, idx: &[u32], mesh: &str) -> Result<Vec<[u32; 3]>, LoadError> {

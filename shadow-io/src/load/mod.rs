@@ -25,6 +25,7 @@ use thiserror::Error;
 
 use shadow_core::camera::{Camera, CameraError};
 use shadow_core::light::{Light, LightError};
+use shadow_core::lightmap::UvLayout;
 use shadow_core::scene::{SceneError, TriangleScene};
 
 /// Upper bounds on what a file may make the loader allocate, and the one choice a loader makes
@@ -136,6 +137,9 @@ pub struct SceneSetup {
     pub warnings: Vec<String>,
     /// The file's `KHR_lights_punctual` lights; each has an area light in `lights`.
     pub punctual: Vec<punctual::PunctualLight>,
+    /// The texture layouts (`TEXCOORD_0`) of the meshes that have one, in file order: what
+    /// `bake --mesh NAME` shadows the texels of.
+    pub layouts: Vec<UvLayout>,
 }
 
 impl SceneSetup {
@@ -155,6 +159,25 @@ impl SceneSetup {
             }
         }
         Ok(())
+    }
+
+    /// The texture layout of the mesh named `name`.
+    ///
+    /// # Errors
+    /// A message naming the meshes that have a layout.
+    pub fn layout(&self, name: &str) -> Result<&UvLayout, String> {
+        self.layouts.iter().find(|l| l.name == name).ok_or_else(|| {
+            let names: Vec<&str> = self.layouts.iter().map(|l| l.name.as_str()).collect();
+            format!(
+                "`{}` has no mesh `{name}` with texture coordinates (TEXCOORD_0); {}",
+                self.name,
+                if names.is_empty() {
+                    "no mesh has them".to_string()
+                } else {
+                    format!("meshes with them: {}", names.join(", "))
+                }
+            )
+        })
     }
 
     /// The file's camera, or one looking at the scene's bounds from the front-top.

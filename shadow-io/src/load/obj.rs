@@ -49,6 +49,7 @@ pub fn load_obj_slice(
         aspect: None,
         warnings,
         punctual: Vec::new(),
+        layouts: Vec::new(),
     })
 }
 

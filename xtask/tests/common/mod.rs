@@ -1,5 +1,8 @@
 //! Shared by the xtask test files: running the built binary, temporary folders.
 
+// Each test file that includes this module uses a part of it.
+#![allow(dead_code)]
+
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -8,6 +11,20 @@ pub fn xtask(args: &[&str]) -> std::process::Output {
         .args(args)
         .output()
         .expect("xtask runs")
+}
+
+/// Asserts that the run succeeded, showing its standard error when not.
+pub fn assert_success(out: &std::process::Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// The `stats.json` a run wrote in `dir`.
+pub fn read_stats(dir: &std::path::Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("stats.json")).unwrap()).unwrap()
 }
 
 pub fn temp_dir(name: &str) -> PathBuf {
