@@ -206,11 +206,6 @@ impl SceneContext {
             .map_err(Clone::clone)
     }
 
-    /// The size, samples, seed and receivers of this context.
-    pub fn config(&self) -> SuiteConfig {
-        self.config
-    }
-
     /// The light every case's main checks use (the scene's first; a scene with several has
     /// every light checked too, [`crate::lights`]).
     pub fn light(&self) -> Light {
@@ -480,8 +475,20 @@ pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
         ),
         None => violations.push("the preset declares no budget for this scene".into()),
     }
-    let every_light =
-        crate::lights::check_every_light(preset, ctx, budget.as_ref(), &mut violations);
+    // Every light of a multi-light scene, on the camera's receivers (the foreign modes check
+    // the receivers on the first light).
+    let every_light = (cfg.receivers == ReceiverMode::Camera)
+        .then(|| {
+            let case = crate::lights::LightsCase {
+                setup: &ctx.setup,
+                view: &ctx.view,
+                seed: cfg.seed,
+                ref_samples: cfg.ref_samples,
+                reference_seed: cfg.seed ^ REFERENCE_SEED_SALT,
+            };
+            crate::lights::check_every_light(preset, &case, budget.as_ref(), &mut violations)
+        })
+        .flatten();
     let mut deterministic = None;
     let mut convergence = None;
     let checks = if cfg.extra_checks {

@@ -16,7 +16,7 @@ use shadow_metrics::{Metrics, compare};
 use shadow_presets::{Budget, Preset};
 use shadow_ref::Reference;
 
-use crate::conformance::{REFERENCE_SEED_SALT, ReceiverMode, SceneContext};
+use shadow_io::SceneSetup;
 
 /// Samples of the fallback that traces the lights a technique without light samples refuses.
 const FALLBACK_SAMPLES: u32 = 256;
@@ -58,17 +58,31 @@ pub struct EveryLight {
     pub direct_tolerance: Option<f64>,
 }
 
-/// Shadows every light of `ctx`'s scene with `preset` and holds each light and the summed direct
-/// light to the reference (`budget` is the preset's for the scene); pushes what fails to
-/// `violations`. `None` on a one-light scene, and for receivers handed in (their modes check
-/// the receivers on the first light; the lights are checked on the camera's).
+/// A case's scene, receivers and reference settings.
+#[derive(Clone, Copy)]
+pub struct LightsCase<'a> {
+    /// The scene with its lights.
+    pub setup: &'a SceneSetup,
+    /// The receivers.
+    pub view: &'a ViewSamples,
+    /// Seed of the technique.
+    pub seed: u64,
+    /// Samples per pixel of the stratified reference.
+    pub ref_samples: u32,
+    /// Seed of the stratified reference (another than the technique's).
+    pub reference_seed: u64,
+}
+
+/// Shadows every light of the case's scene with `preset` and holds each light and the summed
+/// direct light to the reference (`budget` is the preset's for the scene); pushes what fails to
+/// `violations`. `None` on a one-light scene.
 pub fn check_every_light(
     preset: &Preset,
-    ctx: &SceneContext,
+    ctx: &LightsCase,
     budget: Option<&Budget>,
     violations: &mut Vec<String>,
 ) -> Option<EveryLight> {
-    if ctx.setup.lights.len() < 2 || ctx.config().receivers != ReceiverMode::Camera {
+    if ctx.setup.lights.len() < 2 {
         return None;
     }
     match every_light(preset, ctx, budget) {
@@ -86,11 +100,10 @@ pub fn check_every_light(
 /// The preset's and the reference's answers for every light, compared.
 fn every_light(
     preset: &Preset,
-    ctx: &SceneContext,
+    ctx: &LightsCase,
     budget: Option<&Budget>,
 ) -> Result<EveryLight, String> {
-    let cfg = ctx.config();
-    let tech = (preset.make)(cfg.seed);
+    let tech = (preset.make)(ctx.seed);
     let sampler = tech.light_sampler().cloned();
     let (reference, fallback, outputs) = match &sampler {
         Some(s) if tech.capabilities().sample_based => (
@@ -102,15 +115,15 @@ fn every_light(
             },
         ),
         _ => (
-            Reference::stratified(cfg.ref_samples, cfg.seed ^ REFERENCE_SEED_SALT)
+            Reference::stratified(ctx.ref_samples, ctx.reference_seed)
                 .map_err(|e| e.to_string())?,
-            Reference::stratified(FALLBACK_SAMPLES, cfg.seed).map_err(|e| e.to_string())?,
+            Reference::stratified(FALLBACK_SAMPLES, ctx.seed).map_err(|e| e.to_string())?,
             Outputs::VISIBILITY,
         ),
     };
     let run = |t: &dyn ShadowTechnique, fallback: Option<&dyn ShadowTechnique>| {
         PreparedLights::prepare(t, fallback, ctx.setup.scene.clone(), &ctx.setup.lights)
-            .and_then(|all| all.estimate(&ctx.view, outputs))
+            .and_then(|all| all.estimate(ctx.view, outputs))
             .map_err(|e| e.to_string())
     };
     let got = run(tech.as_ref(), Some(&fallback))?;
@@ -130,7 +143,7 @@ fn every_light(
             budget_rmse: own.as_ref().or(budget).map(|b| b.rmse),
         });
     }
-    let direct_relative_rmse = relative_rmse(&got, &truth, &ctx.view);
+    let direct_relative_rmse = relative_rmse(&got, &truth, ctx.view);
     let direct_tolerance = direct_relative_rmse.map(|_| {
         let agreement = budget.and_then(|b| b.min_sample_agreement).unwrap_or(1.0);
         let rmse = budget.map_or(0.0, |b| b.rmse);

@@ -32,9 +32,7 @@ pub struct SampleGrid {
 
 impl SampleGrid {
     /// Fewest samples per set for which the technique uses a grid: below, the plain loop over
-    /// every sample is as fast on llvmpipe (bunny and grass at 128x96: the grid is 17% faster on
-    /// bunny and 8% slower on grass at 128 samples, faster on both from 256, 2.2x on bunny at
-    /// 1024).
+    /// every sample is as fast on llvmpipe (measured on bunny and grass; `docs/benchmarks.md`).
     pub const MIN_SAMPLES: u32 = 128;
 
     /// Buckets per side for `n` samples: about four samples per bucket, at most 32 x 32.

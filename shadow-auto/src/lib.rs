@@ -55,9 +55,9 @@ use probe::{Probe, probe_features, probe_reference};
 
 /// Under a time budget a pick must fit `TIME_MARGIN` times its predicted time: the 0.9
 /// quantile of achieved over predicted time of `auto`'s picks under time budgets on scenes the
-/// models were not fitted on (`cargo xtask budgets`, leave-one-out over 21 scenes,
-/// 2026-12-07: 1.99 at 128x96, 2.24 at 256x192; the median is 0.95), so that nine budgets in
-/// ten are met where the prediction is the only guide.
+/// models were not fitted on (`cargo xtask budgets`, leave-one-out over the built-in scenes;
+/// `docs/benchmarks.md` holds the figures), so that nine budgets in ten are met where the
+/// prediction is the only guide.
 pub const TIME_MARGIN: f64 = 2.0;
 
 /// What `auto` must meet.

@@ -41,26 +41,22 @@
 //! # When DCS pays
 //!
 //! DCS costs per (pixel, silhouette edge) pair and barely per light sample; a ray tracer costs
-//! per ray. Measured against the same-samples reference on a 2-core machine at 512x512 (figures,
-//! command and date in `docs/benchmarks.md`):
+//! per ray. Against the same-samples reference (figures, command, date and machine in
+//! `docs/benchmarks.md`):
 //! * **Few silhouette edges per penumbra pixel** (boxes, planes, a sphere light, most built-in
-//!   scenes): 3.6x to 6.8x the reference's speed at 64 samples by instructions; 12.7x on the
-//!   sphere light.
-//! * **A finely tessellated mesh under a large light** (`bunny`: 28,035 accurate silhouette
-//!   edges, 63 pairs per per-sample pixel): 2.65x at 64 samples by instructions (2.4x to 2.8x
-//!   in wall time), 2.9x with 4 x 4 interleaved sets (their set-up shared), 5.4x at 256 by
-//!   instructions, 0.9x at 16. The pairs grow with the square of the light's size while the
-//!   reference's cost barely moves: with the light's sides scaled by 0.35 (`DCS_LIGHT_SCALE`
-//!   of the examples), `bunny` is 5.1x at 64 samples by instructions, 6.2x at 0.125, 1.3x at 2.
-//! * **Depth complexity in the hundreds** (`grass`): far slower (6x to 27x the reference's
-//!   time at 64 samples, 64x48 to 512x384). Every layer is counted; a ray stops at its first
-//!   hit. The hybrid presets (`dcs-64-hybrid`, [`Dcs::with_rays`], [`technique`]'s `rays`
-//!   module) predict each frame's DCS work from the box hierarchy's (tile, wedge) candidates
-//!   before any per-pixel work and trace the frame on the same samples where rays cost less:
-//!   the same answers, in 1.1x to 2x the reference's time on `grass` instead of 6x to 27x
-//!   (DCS's own preparation and the prediction are what is left), and DCS's time elsewhere.
+//!   scenes): DCS is several times faster at 64 samples, most on sphere lights.
+//! * **A finely tessellated mesh under a large light** (`bunny`, tens of thousands of accurate
+//!   silhouette edges): faster at 64 and 256 samples, not at 16; the pairs grow with the square
+//!   of the light's size while the reference's cost barely moves, so a smaller light widens
+//!   the gap and a larger one closes it.
+//! * **Depth complexity in the hundreds** (`grass`): far slower, since every layer is counted
+//!   where a ray stops at its first hit. The hybrid presets (`dcs-64-hybrid`, [`Dcs::with_rays`],
+//!   [`technique`]'s `rays` module) predict each frame's DCS work from the box hierarchy's
+//!   (tile, wedge) candidates before any per-pixel work and trace the frame on the same samples
+//!   where rays cost less: the same answers, near the reference's time on `grass`, and DCS's
+//!   time elsewhere.
 //! * **Textured lights** weigh every sample of every pixel by its radiance (eq. 2), which both
-//!   pay: 1.7x at 64 samples by instructions.
+//!   pay.
 //!
 //! ```
 //! use shadow_core::prelude::*;

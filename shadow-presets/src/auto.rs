@@ -6,7 +6,7 @@
 //! `scripts/measure_budgets.py` regenerates the tables. The reference's own error at 1024
 //! samples adds to what `auto` achieves against the study's 4096-sample one. The `corpus` rows
 //! hold the largest error over the 44 scenes of the corpus of real meshes
-//! (`cargo xtask conformance --quick --scenes corpus`, folded by `scripts/measure_budgets.py --report ... --corpus`, 2026-12-07; [`crate::CORPUS_ROW`]).
+//! (`cargo xtask conformance --quick --scenes corpus`, folded by `scripts/measure_budgets.py --report ... --corpus`; [`crate::CORPUS_ROW`]).
 
 use shadow_auto::{Auto, AutoBudget};
 use shadow_core::technique::ShadowTechnique;
@@ -47,12 +47,12 @@ const AUTO_01: &[(&str, [f64; 5])] = &[
     ("interior-window", [0.0047, 0.0087, 0.0001, 0.034, 0.0000]),
     ("corpus", [0.0088, 0.0557, 0.0002, 0.188, 0.0017]),
     // Receivers without a camera, where DCS is no candidate (`cargo test -p shadow-tests
-    // --test conformance -- points/auto`, 2026-12-07).
+    // --test conformance -- points/auto`).
     ("bunny@points", [0.0090, 0.0250, 0.0001, 0.099, 0.0000]),
     ("interior@points", [0.0096, 0.0323, 0.0002, 0.119, 0.0003]),
     // `interior`'s light 1, the disk pendant, shadowed with the scene's other lights: a small
     // light where the chooser's cheaper pick lands near its target (`cargo xtask conformance
-    // --scenes interior --quick`, 2026-12-07).
+    // --scenes interior --quick`).
     ("interior#1", [0.0094, 0.0536, 0.0001, 0.177, 0.0020]),
 ];
 

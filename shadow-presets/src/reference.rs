@@ -6,7 +6,7 @@
 //! 1024 samples; `cargo test -p shadow-tests --test conformance -- conformance/` prints them) with the margins of
 //! [`Budget::from_measured`]; `scripts/measure_budgets.py` regenerates the tables.
 //! The `corpus` row of each table holds the largest error over the 44 scenes of the corpus of
-//! real meshes (`cargo xtask conformance --quick --scenes corpus`, folded by `scripts/measure_budgets.py --report ... --corpus`, 2026-12-07): the promise on any of them
+//! real meshes (`cargo xtask conformance --quick --scenes corpus`, folded by `scripts/measure_budgets.py --report ... --corpus`): the promise on any of them
 //! ([`crate::CORPUS_ROW`]).
 //! Textured-light errors are per RGB channel of radiance-weighted visibility (DCS eq. 2), so
 //! they are larger in absolute terms.

@@ -157,20 +157,25 @@ pub fn tables(points: &[Measured], heading: &str) -> (String, String) {
 /// # Errors
 /// When the page cannot be read or written, or lacks the markers.
 pub fn write_docs(page: &Path, table: &str) -> Result<(), String> {
+    replace_between(page, BEGIN, END, table)
+}
+
+/// Replaces the section between the markers `begin` and `end` of `page` with `table`.
+///
+/// # Errors
+/// When the page cannot be read or written, or lacks the markers.
+pub fn replace_between(page: &Path, begin: &str, end: &str, table: &str) -> Result<(), String> {
     let text = std::fs::read_to_string(page).map_err(|e| format!("{}: {e}", page.display()))?;
-    let (Some(a), Some(b)) = (text.find(BEGIN), text.find(END)) else {
+    let (Some(a), Some(b)) = (text.find(begin), text.find(end)) else {
         return Err(format!(
-            "{} has no `{BEGIN}` ... `{END}` section to regenerate",
+            "{} has no `{begin}` ... `{end}` section to regenerate",
             page.display()
         ));
     };
     if b < a {
-        return Err(format!(
-            "{}: the summary markers are out of order",
-            page.display()
-        ));
+        return Err(format!("{}: the markers are out of order", page.display()));
     }
-    let out = format!("{}{BEGIN}\n{table}{}", &text[..a], &text[b..]);
+    let out = format!("{}{begin}\n{table}{}", &text[..a], &text[b..]);
     std::fs::write(page, out).map_err(|e| format!("{}: {e}", page.display()))
 }
 

@@ -5,6 +5,7 @@
 //! * `bake`: a lightmap over a mesh's texture layout, from every light.
 //! * `conformance`: the main job, every preset on every supported built-in scene, with a report.
 //! * `bench`: run time against error, reference curves and scaling sweeps, CSV/JSON and plots.
+//! * `bench-receivers`: receivers handed in (a G-buffer, points) against the camera path.
 //! * `stress`: the numerical-stability suite against every preset.
 //! * `budgets`: the adaptive reference against the uniform one at equal error, and the ratio
 //!   estimator of direct light against eq. 6.
@@ -12,6 +13,7 @@
 mod auto_study;
 mod bake;
 mod bench;
+mod bench_receivers;
 mod bench_summary;
 mod budgets;
 mod common;
@@ -49,6 +51,8 @@ enum Command {
     Conformance(conformance::ConformanceArgs),
     /// Benchmark run time against error; scaling sweeps; CSV, JSON and plots.
     Bench(bench::BenchArgs),
+    /// What receivers handed in (a foreign G-buffer, points) cost against the camera path.
+    BenchReceivers(bench_receivers::BenchReceiversArgs),
     /// The numerical-stability suite against every preset.
     Stress(stress::StressArgs),
     /// The adaptive reference against the uniform one at equal error; the ratio estimator of
@@ -102,6 +106,7 @@ fn main() -> ExitCode {
         Command::Bake(a) => bake::run(a),
         Command::Conformance(a) => conformance::run(a),
         Command::Bench(a) => bench::run(a),
+        Command::BenchReceivers(a) => bench_receivers::run(a),
         Command::Stress(a) => stress::run(a),
         Command::Budgets(a) => budgets::run(a),
     };

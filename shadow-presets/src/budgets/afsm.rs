@@ -2,10 +2,10 @@
 //! penumbra rmse, bias, max, share > 0.1]; seed 1), each value the larger of the two sizes the
 //! presets run at: 128 x 96 (`cargo xtask conformance --techniques afsm-hard,afsm-128-lut
 //! --quick`) and 48 x 36 (the same with `--width 48 --height 36`, the size `cargo test` uses for
-//! GPU presets), 2026-11-22, lavapipe. The `corpus` rows hold the largest error over the 44
+//! GPU presets) on lavapipe. The `corpus` rows hold the largest error over the 44
 //! scenes of the corpus of real meshes at both sizes (`--scenes corpus`, folded by
-//! `scripts/measure_budgets.py --report ... --corpus`, then `--max` for the second size,
-//! 2026-12-07; [`crate::CORPUS_ROW`]).
+//! `scripts/measure_budgets.py --report ... --corpus`, then `--max` for the second size;
+//! [`crate::CORPUS_ROW`]).
 
 /// `afsm-hard` against the area light's reference (the error of a hard shadow).
 pub const AFSM_HARD: &[(&str, [f64; 5])] = &[

@@ -1,11 +1,11 @@
 //! Measured error tables of the DCS presets against the same-samples reference (scene, [rmse,
 //! penumbra rmse, bias, max, share > 0.1]; 128 x 96, seed 1), from `cargo xtask conformance
-//! --techniques dcs-16,dcs-64,dcs-64-interleaved,dcs-256,dcs-standard-silhouettes --quick`
-//! (2026-11-22). The exact presets agree with the reference sample by sample, so only their
+//! --techniques dcs-16,dcs-64,dcs-64-interleaved,dcs-256,dcs-standard-silhouettes --quick`.
+//! The exact presets agree with the reference sample by sample, so only their
 //! semi-opaque error (the saturating opacity sum against the exact transmittance product,
 //! section 3) is measured; elsewhere they get [`crate::dcs`]'s tie budget, on the built-in
 //! scenes and the corpus of real meshes alike. The `corpus` rows hold the largest error over
-//! the 44 corpus scenes (`cargo xtask conformance --quick --scenes corpus`, folded by `scripts/measure_budgets.py --report ... --corpus`, 2026-12-07; [`crate::CORPUS_ROW`]).
+//! the 44 corpus scenes (`cargo xtask conformance --quick --scenes corpus`, folded by `scripts/measure_budgets.py --report ... --corpus`; [`crate::CORPUS_ROW`]).
 
 /// `dcs-16`.
 pub const DCS_16_SEMI: &[(&str, [f64; 5])] =

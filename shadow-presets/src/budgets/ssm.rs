@@ -2,14 +2,14 @@
 //! samples (scene, [rmse, penumbra rmse, bias, max, share > 0.1]; 128 x 96, seed 1), from
 //! `cargo xtask conformance --techniques pcf,pcss` and, for the back-projection, peeling,
 //! contour and adaptive presets, `--techniques ssm-backprojection,ssm-peeling,ssm-contours,ssm-adaptive`
-//! (2026-11-22; textured-light is RGB; `ssm-peeling` again on 2026-12-07, with its layers'
-//! back-projections united instead of summed), and their measured false-shadow
+//! (textured-light is RGB; `ssm-peeling` with its layers' back-projections united instead of
+//! summed), and their measured false-shadow
 //! shares (reference-lit pixels darkened by more than 0.1: shadow-map aliasing at contacts and
 //! silhouettes).
 //!
 //! The `corpus` rows hold the largest error over the 44 scenes of the corpus of real meshes
 //! (`cargo xtask conformance --quick --scenes corpus`, folded by `scripts/measure_budgets.py
-//! --report ... --corpus`, 2026-12-07; [`crate::CORPUS_ROW`]). Their max error
+//! --report ... --corpus`; [`crate::CORPUS_ROW`]). Their max error
 //! reaches 1 on a few pixels while RMSE stays at 0.02 to 0.04: on `corpus-cow-rect-quarter`
 //! (128 x 96) `ssm-backprojection` and `ssm-peeling` are off by more than 0.5 on three pixels,
 //! the floor under a hoof's rim (reference 0, these 0.95) and two on the cow's flank (0.27 and
