@@ -412,3 +412,40 @@ fn the_circle_finder_finds_a_circle_between_siblings_and_none_through_a_parent()
     assert_eq!(circle.first(), circle.last());
     std::fs::remove_dir_all(&src).unwrap();
 }
+
+/// The most lines a Rust source file of the workspace may hold (ARCHITECTURE.md: small modules
+/// named for what they do).
+const MAX_FILE_LINES: usize = 800;
+
+/// Every `.rs` file under `dir`, skipping build output and the one-technique fixture's own.
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let path = e.path();
+        let name = e.file_name();
+        if path.is_dir() {
+            if name != "target" && name != ".git" && name != "out" {
+                rust_files(&path, out);
+            }
+        } else if path.extension().is_some_and(|x| x == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+#[test]
+fn no_source_file_is_over_800_lines() {
+    let mut files = Vec::new();
+    rust_files(&root(), &mut files);
+    assert!(files.len() > 100, "found {} source files", files.len());
+    let long: Vec<String> = files
+        .iter()
+        .filter_map(|f| {
+            let n = std::fs::read_to_string(f).ok()?.lines().count();
+            (n > MAX_FILE_LINES).then(|| format!("{} ({n} lines)", f.display()))
+        })
+        .collect();
+    assert!(long.is_empty(), "over {MAX_FILE_LINES} lines: {long:?}");
+}
