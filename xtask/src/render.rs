@@ -186,7 +186,9 @@ fn foreign_gbuffer(
         .map_err(|e| format!("{}: {e}", dir.display()))
 }
 
-pub fn run(a: RenderArgs) -> Result<(), String> {
+/// The scene with the command line's overrides (light size, light, camera), recentred when it
+/// sits far from the origin, and the shift that was added to every position.
+fn scene_for(a: &RenderArgs) -> Result<(SceneSetup, Vec3), String> {
     let mut setup = resolve_scene(&a.scene, a.light.is_some(), a.emissive_as_geometry)?;
     if let Some(r) = a.light_size {
         if a.light.is_some() || setup.punctual.is_empty() {
@@ -214,8 +216,19 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         setup.camera = Some(crate::overrides::camera(spec)?);
         setup.aspect = None;
     }
+    // Far from the origin, work where single precision is dense (issue 51 item 11); positions
+    // are written back in the file's coordinates.
+    match shadow_scenes::recentred(&setup).map_err(|e| e.to_string())? {
+        Some((moved, by)) => Ok((moved, by)),
+        None => Ok((setup, Vec3::ZERO)),
+    }
+}
+
+/// The technique `--technique` names (with `--samples`, or `auto` under `--rmse` or
+/// `--seconds`), if any.
+fn technique_for(a: &RenderArgs) -> Result<Option<Box<dyn ShadowTechnique>>, String> {
     let technique = match a.technique.as_deref() {
-        Some("auto") => Some(auto_technique(&a)?),
+        Some("auto") => Some(auto_technique(a)?),
         Some(t) => {
             if a.rmse.is_some() || a.seconds.is_some() {
                 return Err("--rmse and --seconds go with --technique auto".into());
@@ -227,91 +240,66 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
     if a.technique.is_none() && a.samples.is_some() && !a.direct {
         return Err("--samples needs --technique or --direct".into());
     }
-    // Far from the origin, work where single precision is dense (issue 51 item 11); positions
-    // are written back in the file's coordinates.
-    let mut shift = Vec3::ZERO;
-    if let Some((moved, by)) = shadow_scenes::recentred(&setup).map_err(|e| e.to_string())? {
-        setup = moved;
-        shift = by;
-    }
-    let light_indices = chosen_lights(&setup, a.light_index)?;
-    let lights: Vec<Light> = light_indices
-        .iter()
-        .map(|&i| setup.lights[i].clone())
-        .collect();
+    Ok(technique)
+}
+
+/// The receivers (the camera's view samples, or `--gbuffer`'s snapped onto the scene) and the
+/// seconds they took; an error when none is valid.
+fn view_for(a: &RenderArgs, setup: &SceneSetup, shift: Vec3) -> Result<(ViewSamples, f64), String> {
     let height = a.height.unwrap_or_else(|| match setup.aspect {
         Some(r) if r > 0.0 && r.is_finite() => ((a.width as f32 / r).round() as u32).max(1),
         _ => (a.width * 3 / 4).max(1),
     });
-    ensure_dir(&a.out)?;
-    // A failed run must not leave an older run's images beside its error.
-    remove_outputs(&a.out)?;
-    let pb = progress(if technique.is_some() { 4 } else { 2 }, "view samples");
     let camera = setup.camera_or_default();
     let t0 = Instant::now();
     let view = match &a.gbuffer {
-        Some(dir) => foreign_gbuffer(dir, &setup, a.camera.is_some().then_some(&camera), shift)?,
+        Some(dir) => foreign_gbuffer(dir, setup, a.camera.is_some().then_some(&camera), shift)?,
         None => ViewSamples::render(setup.scene.as_ref(), &camera, a.width, height)
             .map_err(|e| e.to_string())?,
     };
-    let (width, height) = (view.width(), view.height());
-    let view_seconds = t0.elapsed().as_secs_f64();
     if view.valid_count() == 0 {
         return Err(format!(
-            "the camera sees no surface of `{}` at {}x{height} (is the scene in front of the \
+            "the camera sees no surface of `{}` at {}x{} (is the scene in front of the \
              camera and beyond its near plane?)",
-            setup.name, width
+            setup.name,
+            view.width(),
+            view.height()
         ));
     }
-    pb.inc(1);
-    write_receivers(&a.out, &view, shift)?;
-    pb.inc(1);
-    let mut stats = json!({
-        "scene": setup.name,
-        "triangles": setup.scene.triangle_count(),
-        "light_index": a.light_index,
-        "width": width,
-        "height": height,
-        "receivers": if a.gbuffer.is_some() { "gbuffer" } else { "camera" },
-        "unmatched_receivers": view.unmatched_receivers(),
-        "valid_pixels": view.valid_count(),
-        "seed": a.seed,
-        "threads": rayon::current_num_threads(),
-        "gpu_adapter": serde_json::Value::Null,
-        "view_samples_seconds": view_seconds,
-        "recentred_by": (shift != Vec3::ZERO).then(|| shift.to_array()),
-        "machine": machine(),
-    });
-    let fallback = match &a.fallback {
-        Some(f) if technique.is_some() => Some(resolve_technique(f, None, a.seed)?),
-        Some(_) => return Err("--fallback goes with --technique".into()),
-        None => None,
-    };
-    let shadowing = match technique.as_ref() {
-        Some(t) => Some((
-            t.as_ref(),
-            Outputs {
-                per_sample: a.direct && t.light_sampler().is_some(),
-                direct: a.direct,
-            },
-        )),
-        None => None,
-    };
-    if let Some((t, outputs)) = shadowing {
-        pb.set_message(format!("{}: prepare", t.name()));
-        let all = PreparedLights::prepare(t, fallback.as_deref(), setup.scene.clone(), &lights)
-            .map_err(|e| light_error(e, &light_indices))?;
-        pb.inc(1);
-        pb.set_message(format!("{}: estimate", t.name()));
+    Ok((view, t0.elapsed().as_secs_f64()))
+}
+
+/// What a render shadows and where it writes: the lights chosen, with their indices in the
+/// scene, and the receivers.
+struct Shading<'a> {
+    out: &'a std::path::Path,
+    setup: &'a SceneSetup,
+    lights: Vec<Light>,
+    indices: Vec<usize>,
+    view: &'a ViewSamples,
+}
+
+impl Shading<'_> {
+    /// Every chosen light shadowed by `t` (the refused ones by `fallback`): V per light,
+    /// `shaded.png`, direct light with `outputs.direct`, and their statistics in `stats`.
+    fn with_technique(
+        &self,
+        t: &dyn ShadowTechnique,
+        fallback: Option<&dyn ShadowTechnique>,
+        outputs: Outputs,
+        stats: &mut serde_json::Value,
+    ) -> Result<(), String> {
+        let (lights, indices, view) = (&self.lights, &self.indices, self.view);
+        let all = PreparedLights::prepare(t, fallback, self.setup.scene.clone(), lights)
+            .map_err(|e| light_error(e, indices))?;
         let est = all
-            .estimate(&view, outputs)
-            .map_err(|e| light_error(e, &light_indices))?;
-        pb.inc(1);
-        write_lights(&a.out, &setup, &lights, &light_indices, &view, &est)?;
+            .estimate(view, outputs)
+            .map_err(|e| light_error(e, indices))?;
+        write_lights(self.out, self.setup, lights, indices, view, &est)?;
         if let Some(direct) = &est.direct {
-            write_direct(&a.out, "direct", &view, direct)?;
+            write_direct(self.out, "direct", view, direct)?;
             let ratio = match t.light_sampler() {
-                Some(sampler) => write_ratio(&a.out, &setup, &lights, sampler, &view, &est)?,
+                Some(sampler) => write_ratio(self.out, self.setup, lights, sampler, view, &est)?,
                 None => false,
             };
             stats["direct_illumination"] = json!({
@@ -326,7 +314,7 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         stats["samples"] = t.light_sampler().map_or(json!(null), |s| json!(s.count()));
         stats["prepare"] = serde_json::to_value(all.preparation()).map_err(|e| e.to_string())?;
         stats["estimate"] = serde_json::to_value(&est.stats).map_err(|e| e.to_string())?;
-        stats["lights"] = lights_json(&light_indices, &lights, &est);
+        stats["lights"] = lights_json(indices, lights, &est);
         if let [one] = est.lights.as_slice() {
             stats["classes"] = json!(one.estimate.visibility.class_counts());
             if !one.estimate.decision.is_null() {
@@ -338,44 +326,106 @@ pub fn run(a: RenderArgs) -> Result<(), String> {
         if let Some(r) = rays_per_second_per_thread(&est.stats) {
             stats["occlusion_rays_per_second_per_thread"] = json!(r);
         }
+        Ok(())
     }
-    if a.direct && technique.is_none() {
-        pb.set_message("direct illumination");
-        let r = shadow_ref::Reference::stratified(a.samples.unwrap_or(256), a.seed)
-            .map_err(|e| e.to_string())?;
+
+    /// Direct light without a technique: the reference's at `samples`, summed over the lights,
+    /// with its ratio estimator.
+    fn reference_direct(
+        &self,
+        samples: u32,
+        seed: u64,
+        stats: &mut serde_json::Value,
+    ) -> Result<(), String> {
+        let r = shadow_ref::Reference::stratified(samples, seed).map_err(|e| e.to_string())?;
         let t0 = Instant::now();
-        let est = PreparedLights::prepare(&r, None, setup.scene.clone(), &lights)
-            .and_then(|all| {
-                all.estimate(
-                    &view,
-                    Outputs {
-                        per_sample: true,
-                        direct: true,
-                    },
-                )
-            })
-            .map_err(|e| light_error(e, &light_indices))?;
+        let outputs = Outputs {
+            per_sample: true,
+            direct: true,
+        };
+        let est = PreparedLights::prepare(&r, None, self.setup.scene.clone(), &self.lights)
+            .and_then(|all| all.estimate(self.view, outputs))
+            .map_err(|e| light_error(e, &self.indices))?;
         let direct = est
             .direct
             .as_deref()
             .ok_or("the reference gave no direct light")?;
-        write_direct(&a.out, "direct", &view, direct)?;
+        write_direct(self.out, "direct", self.view, direct)?;
         let sampler = r.light_sampler().ok_or("the reference has no sampler")?;
-        let ratio = write_ratio(&a.out, &setup, &lights, sampler, &view, &est)?;
+        let ratio = write_ratio(self.out, self.setup, &self.lights, sampler, self.view, &est)?;
         stats["direct_illumination"] = json!({
             "technique": r.name(),
-            "samples": a.samples.unwrap_or(256),
+            "samples": samples,
             "seconds": t0.elapsed().as_secs_f64(),
             "ratio_estimator": ratio,
         });
+        Ok(())
+    }
+}
+
+pub fn run(a: RenderArgs) -> Result<(), String> {
+    let (setup, shift) = scene_for(&a)?;
+    let technique = technique_for(&a)?;
+    let fallback = match &a.fallback {
+        Some(f) if technique.is_some() => Some(resolve_technique(f, None, a.seed)?),
+        Some(_) => return Err("--fallback goes with --technique".into()),
+        None => None,
+    };
+    let indices = chosen_lights(&setup, a.light_index)?;
+    ensure_dir(&a.out)?;
+    // A failed run must not leave an older run's images beside its error.
+    remove_outputs(&a.out)?;
+    let pb = progress(if technique.is_some() { 3 } else { 2 }, "view samples");
+    let (view, view_seconds) = view_for(&a, &setup, shift)?;
+    pb.inc(1);
+    write_receivers(&a.out, &view, shift)?;
+    pb.inc(1);
+    let mut stats = json!({
+        "scene": setup.name,
+        "triangles": setup.scene.triangle_count(),
+        "light_index": a.light_index,
+        "width": view.width(),
+        "height": view.height(),
+        "receivers": if a.gbuffer.is_some() { "gbuffer" } else { "camera" },
+        "unmatched_receivers": view.unmatched_receivers(),
+        "valid_pixels": view.valid_count(),
+        "seed": a.seed,
+        "threads": rayon::current_num_threads(),
+        "gpu_adapter": serde_json::Value::Null,
+        "view_samples_seconds": view_seconds,
+        "recentred_by": (shift != Vec3::ZERO).then(|| shift.to_array()),
+        "machine": machine(),
+    });
+    let shading = Shading {
+        out: &a.out,
+        setup: &setup,
+        lights: indices.iter().map(|&i| setup.lights[i].clone()).collect(),
+        indices,
+        view: &view,
+    };
+    match &technique {
+        Some(t) => {
+            pb.set_message(format!("{}: every light", t.name()));
+            let outputs = Outputs {
+                per_sample: a.direct && t.light_sampler().is_some(),
+                direct: a.direct,
+            };
+            shading.with_technique(t.as_ref(), fallback.as_deref(), outputs, &mut stats)?;
+            pb.inc(1);
+        }
+        None if a.direct => {
+            pb.set_message("direct illumination");
+            shading.reference_direct(a.samples.unwrap_or(256), a.seed, &mut stats)?;
+        }
+        None => {}
     }
     pb.finish_and_clear();
     write_json(&a.out.join("stats.json"), &stats)?;
     println!(
         "wrote {} ({}x{}, {} valid pixels)",
         a.out.display(),
-        width,
-        height,
+        view.width(),
+        view.height(),
         view.valid_count()
     );
     Ok(())
