@@ -17,6 +17,8 @@
 //! * [`lights`]: every light of a scene, V per light and direct light summed.
 //! * [`receivers`]: receivers handed in by the caller (a renderer's G-buffer, or points with
 //!   normals), snapped onto the scene.
+//! * [`spatial_order`]: receivers without a camera laid out coherently for a technique's
+//!   tiles and neighbours, and given back in the caller's order.
 //! * [`rays`]: the shadow-ray traits a hybrid technique takes its rays through, so that no
 //!   technique crate depends on the reference.
 //! * `gpu` (feature `gpu`): wgpu device creation with a software fallback, upload, readback
@@ -75,6 +77,7 @@ pub mod receivers;
 mod rounding;
 pub mod sampling;
 pub mod scene;
+pub mod spatial_order;
 pub mod technique;
 pub mod topology;
 pub mod triangulate;

@@ -41,12 +41,17 @@ pub struct ViewSamples {
     pub(crate) albedo: Option<Vec<Vec3>>,
     /// Receivers that matched no surface and were offset by the caller's tolerance.
     pub(crate) unmatched: u64,
+    /// The pixel each receiver's light samples are drawn for, where it is not its place in
+    /// this layout (receivers reordered by [`crate::spatial_order::SpatialOrder`]).
+    pub(crate) sample_pixels: Option<Vec<UVec2>>,
 }
 
 /// One valid view sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ViewSample {
-    /// Pixel coordinates.
+    /// Pixel coordinates: the pixel its light samples are drawn for. Its place in the layout,
+    /// except for receivers a technique reordered ([`crate::spatial_order::SpatialOrder`]),
+    /// which keep the caller's pixel so that their samples do not change.
     pub pixel: UVec2,
     /// World position on the surface.
     pub position: Vec3,
@@ -165,6 +170,7 @@ impl ViewSamples {
             depth,
             albedo: None,
             unmatched: 0,
+            sample_pixels: None,
         })
     }
 
@@ -203,6 +209,18 @@ impl ViewSamples {
             unmatched: (0..n)
                 .filter(|&i| self.triangle[source(i)] == FREE_RECEIVER)
                 .count() as u64,
+            sample_pixels: self
+                .sample_pixels
+                .as_ref()
+                .map(|k| (0..n).map(|i| k[source(i)]).collect()),
+        }
+    }
+
+    /// The pixel receiver `i`'s light samples are drawn for ([`ViewSample::pixel`]).
+    pub(crate) fn sample_pixel(&self, i: usize) -> UVec2 {
+        match &self.sample_pixels {
+            Some(k) => k[i],
+            None => UVec2::new(i as u32 % self.width, i as u32 / self.width),
         }
     }
 
@@ -283,7 +301,7 @@ impl ViewSamples {
     #[inline]
     fn sample_at(&self, i: usize, pixel: UVec2) -> Option<ViewSample> {
         self.is_valid(i).then(|| ViewSample {
-            pixel,
+            pixel: self.sample_pixels.as_ref().map_or(pixel, |k| k[i]),
             position: self.position[i],
             geometric_normal: self.geometric_normal[i],
             shading_normal: self.shading_normal[i],

@@ -618,7 +618,7 @@ impl PreparedShadows for PreparedAdaptive {
 
     /// The adaptive pass computes direct light beside the visibility, from the same samples.
     /// Receivers without a camera are laid out along a space-filling curve first
-    /// ([`shadow_core::receivers::SpatialOrder`]), since the variance is pooled over image
+    /// ([`shadow_core::spatial_order::SpatialOrder`]), since the variance is pooled over image
     /// neighbours, and answered in the caller's order.
     fn pass(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError> {
         if view.raster_view().is_some() {

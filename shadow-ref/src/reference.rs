@@ -22,6 +22,7 @@
 //! or yields a short candidate list; only receivers whose beam holds many triangles query the
 //! CWBVH segment by segment, last occluder first.
 
+use shadow_core::spatial_order::in_spatial_order;
 use std::sync::Arc;
 
 use glam::{UVec2, Vec2, Vec3};
@@ -566,9 +567,11 @@ impl PreparedShadows for PreparedReference {
         self.p.light.as_ref()
     }
 
+    /// A caller's points are traced in a spatial order, so that beams hold receivers close in
+    /// space ([`in_spatial_order`]).
     fn pass(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError> {
         let per_sample = self.config.per_sample || outputs.per_sample;
-        self.config.run(&self.p, view, per_sample)
+        in_spatial_order(view, |v| self.config.run(&self.p, v, per_sample))
     }
 
     fn direct_light(&self, view: &ViewSamples, _: &Estimate) -> Result<Vec<Vec3>, TechniqueError> {

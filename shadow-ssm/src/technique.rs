@@ -30,6 +30,7 @@ use serde_json::json;
 use shadow_core::light::LightKind;
 use shadow_core::offset::RayOffset;
 use shadow_core::prelude::*;
+use shadow_core::spatial_order::in_spatial_order;
 use shadow_core::technique::{Capabilities, Processor, SceneRef};
 use shadow_core::visibility::{Coefficients, PixelClass};
 
@@ -428,8 +429,10 @@ impl PreparedShadows for PreparedFilter {
         Ok(())
     }
 
+    /// A caller's points are shadowed in a spatial order, so that neighbouring receivers read
+    /// neighbouring shadow-map texels ([`in_spatial_order`]).
     fn pass(&self, view: &ViewSamples, _outputs: Outputs) -> Result<Estimate, TechniqueError> {
-        self.config.run(&self.p, view)
+        in_spatial_order(view, |v| self.config.run(&self.p, v))
     }
 }
 
