@@ -7,7 +7,9 @@
 //! never a panic or an unbounded allocation.
 
 mod emissive;
+mod gltf_accessors;
 mod gltf_loader;
+mod gltf_nodes;
 mod obj;
 pub mod punctual;
 mod texture;
