@@ -453,17 +453,13 @@ pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
     }
     .or_else(|| (preset.budget)(&ctx.setup.name));
     let mut notes = Vec::new();
-    if !est.decision.is_null() {
-        let d = &est.decision;
+    if let Some(d) = shadow_auto::Decision::of(&est) {
         notes.push(format!(
             "chose {} ({}): predicted RMSE {:.4} in {:.4} s, achieved {:.4} in {:.4} s",
-            d["choice"].as_str().unwrap_or("?"),
-            d["reason"].as_str().unwrap_or("?"),
-            d["predicted"]["rmse"].as_f64().unwrap_or(f64::NAN),
-            d["predicted"]["seconds"].as_f64().unwrap_or(f64::NAN),
-            metrics.rmse,
-            seconds,
+            d.choice, d.reason, d.predicted.rmse, d.predicted.seconds, metrics.rmse, seconds,
         ));
+    } else if let Some(d) = &est.decision {
+        notes.push(format!("chose {} ({})", d.choice(), d.reason()));
     }
     // The budget's image: not another size, nor the same receivers as points in another
     // layout, whose light sample sets (drawn per pixel) are another draw of the tail.

@@ -3,12 +3,18 @@
 //! under an error budget whatever the thread count, gives the outputs asked for, picks the
 //! fastest prediction when nothing fits a time budget, and refuses bad budgets.
 
-use shadow_auto::{Auto, AutoBudget};
+use shadow_auto::statistics::{AutoCounter, AutoPhase};
+use shadow_auto::{Auto, AutoBudget, Decision};
 use shadow_core::prelude::*;
 use shadow_io::SceneSetup;
 use shadow_metrics::compare;
 use shadow_ref::Reference;
 use shadow_scenes::builtin;
+
+/// The decision `auto` made for `e`.
+fn decision(e: &Estimate) -> &Decision {
+    Decision::of(e).expect("auto records its decision")
+}
 
 fn view_of(setup: &SceneSetup, w: u32, h: u32) -> ViewSamples {
     ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), w, h).unwrap()
@@ -36,15 +42,15 @@ fn auto_meets_rmse_budgets_and_says_what_it_chose() {
             let auto = Auto::new(AutoBudget::Rmse(budget), 1, shadow_presets::build).unwrap();
             let e = run(&auto, &setup, &view, Outputs::VISIBILITY);
             let rmse = compare(&e.visibility, &truth.visibility).unwrap().rmse;
-            let choice = e.decision["choice"].as_str().unwrap();
+            let choice = decision(&e).choice.as_str();
             assert!(
                 rmse <= 1.5 * budget + 0.002,
                 "{scene} RMSE budget {budget}: {choice} gave {rmse}"
             );
-            let predicted = e.decision["predicted"]["rmse"].as_f64().unwrap();
+            let predicted = decision(&e).predicted.rmse;
             assert!(predicted.is_finite() && predicted >= 0.0);
-            assert!(e.stats.counter("auto-candidates").unwrap() > 0);
-            assert!(e.stats.phase_seconds("auto-probe").is_some());
+            assert!(e.stats.counter(AutoCounter::AutoCandidates).unwrap() > 0);
+            assert!(e.stats.phase_seconds(AutoPhase::AutoProbe).is_some());
         }
     }
 }
@@ -60,7 +66,7 @@ fn auto_under_an_error_budget_is_deterministic_whatever_the_thread_count() {
         .unwrap();
     let a = one.install(|| run(&auto, &setup, &view, Outputs::VISIBILITY));
     let b = run(&auto, &setup, &view, Outputs::VISIBILITY);
-    assert_eq!(a.decision["choice"], b.decision["choice"]);
+    assert_eq!(decision(&a).choice, decision(&b).choice);
     assert_eq!(a.visibility.coefficients(), b.visibility.coefficients());
 }
 
@@ -84,25 +90,14 @@ fn nothing_fits_a_tiny_time_budget_so_auto_takes_the_fastest_prediction() {
     let view = view_of(&setup, 48, 36);
     let auto = Auto::new(AutoBudget::Seconds(1e-9), 1, shadow_presets::build).unwrap();
     let e = run(&auto, &setup, &view, Outputs::VISIBILITY);
-    let fastest = e.decision["candidates"]
-        .as_array()
-        .unwrap()
+    let d = decision(&e);
+    let fastest = d
+        .candidates
         .iter()
-        .min_by(|a, b| {
-            a["seconds"]
-                .as_f64()
-                .unwrap()
-                .total_cmp(&b["seconds"].as_f64().unwrap())
-        })
-        .unwrap()["name"]
-        .clone();
-    assert_eq!(e.decision["choice"], fastest);
-    assert!(
-        e.decision["reason"]
-            .as_str()
-            .unwrap()
-            .contains("the fastest")
-    );
+        .min_by(|a, b| a.seconds.total_cmp(&b.seconds))
+        .unwrap();
+    assert_eq!(d.choice, fastest.name);
+    assert!(d.reason.contains("the fastest"));
 }
 
 #[test]
@@ -185,10 +180,16 @@ fn the_dcs_probe_measures_what_the_reference_probe_measures() {
     let prepared = auto
         .prepare(setup.scene.clone(), setup.lights[0].clone())
         .unwrap();
-    assert_eq!(prepared.preparation().counter("auto-probe-dcs"), Some(1));
+    assert_eq!(
+        prepared.preparation().counter(AutoCounter::AutoProbeDcs),
+        Some(1)
+    );
     let e = prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
-    assert!(e.decision["choice"].as_str().unwrap().starts_with("dcs-"));
-    assert_eq!(e.stats.counter("auto-probe-preparation-reused"), Some(1));
+    assert!(decision(&e).choice.as_str().starts_with("dcs-"));
+    assert_eq!(
+        e.stats.counter(AutoCounter::AutoProbePreparationReused),
+        Some(1)
+    );
     assert_eq!(chosen("semi-opaque"), ProbeKind::Reference);
     assert_eq!(chosen("grass"), ProbeKind::Reference);
     let setup = builtin("semi-opaque").unwrap();

@@ -11,7 +11,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use shadow_afsm::Afsm;
+use shadow_afsm::statistics::{AfsmCounter, AfsmGauge};
 use shadow_core::prelude::*;
+use shadow_core::stats::Counter;
 use shadow_metrics::compare;
 use shadow_ref::Reference;
 
@@ -74,59 +76,36 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         m.rmse
     );
     for p in &est.stats.phases {
-        let device = est.stats.counter(&format!("{}-device-ns", p.name));
-        match device {
-            Some(ns) => println!(
-                "  phase {:<16} {:.4} s (device {:.4} s by timestamp queries)",
-                p.name,
-                p.seconds,
-                ns as f64 * 1e-9
+        match p.device_seconds {
+            Some(device) => println!(
+                "  phase {:<16} {:.4} s (device {device:.4} s by timestamp queries)",
+                p.name, p.seconds
             ),
             None => println!("  phase {:<16} {:.4} s", p.name, p.seconds),
         }
     }
-    let occupied = est.stats.counter("lists-occupied").unwrap();
-    let listed = est.stats.counter("receivers-listed").unwrap();
-    let side = est.stats.gauge("map-side").unwrap();
+    let occupied = est.stats.counter(AfsmCounter::ListsOccupied).unwrap();
+    let listed = est.stats.counter(AfsmCounter::ReceiversListed).unwrap();
+    let side = est.stats.gauge(AfsmGauge::MapSide).unwrap();
     println!(
         "  lists: {occupied} occupied of {} ({:.1}%), average length {:.2}, longest {}",
         side * side,
         100.0 * occupied as f64 / (side * side) as f64,
         listed as f64 / occupied.max(1) as f64,
-        est.stats.gauge("list-length-max").unwrap()
+        est.stats.gauge(AfsmGauge::ListLengthMax).unwrap()
     );
-    for k in [
-        "pairs-tested",
-        "pairs-empty",
-        "pairs-full",
-        "pairs-per-sample",
-        "pairs-one-sample",
-        "texels-visited",
-        "silhouette-edges",
-        "receiver-batches",
-        "receivers-listed",
-        "tiles-culled",
-        "texels-culled-by-depth",
-        "pairs-after-umbra",
-        "tiles-empty",
-        "texels-hidden",
-        "tiles-hidden",
-        "texels-culled-by-region",
-        "texels-culled-by-volume",
-        "super-tiles-culled",
-        "casters-culled",
-        "tiles-numbered",
-    ] {
-        println!("  {k} {}", est.stats.counter(k).unwrap_or(0));
+    for &k in AfsmCounter::ALL {
+        println!("  {} {}", k.name(), est.stats.counter(k).unwrap_or(0));
     }
-    let count = |k: &str| est.stats.counter(k).unwrap_or(0);
+    let count = |k: AfsmCounter| est.stats.counter(k).unwrap_or(0);
     println!(
         "| {scene} | {t_afsm:.3} | {t_ref:.3} | {:.1} | {} | {:.0}% | {} | {} |",
         t_afsm / t_ref,
-        count("pairs-tested"),
-        100.0 * count("pairs-empty") as f64 / count("pairs-tested").max(1) as f64,
-        count("tiles-culled"),
-        count("pairs-after-umbra"),
+        count(AfsmCounter::PairsTested),
+        100.0 * count(AfsmCounter::PairsEmpty) as f64
+            / count(AfsmCounter::PairsTested).max(1) as f64,
+        count(AfsmCounter::TilesCulled),
+        count(AfsmCounter::PairsAfterUmbra),
     );
     Ok(())
 }

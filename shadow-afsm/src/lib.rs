@@ -30,7 +30,7 @@
 //! `SHADOW_REQUIRE_GPU` is set).
 //!
 //! ```
-//! use shadow_afsm::Afsm;
+//! use shadow_afsm::{Afsm, AfsmCounter};
 //! use shadow_core::prelude::*;
 //!
 //! let setup = shadow_scenes::builtin("quad-over-plane").unwrap();
@@ -39,7 +39,7 @@
 //! match afsm.prepare(setup.scene.clone(), setup.lights[0].clone()) {
 //!     Ok(prepared) => {
 //!         let est = prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
-//!         assert!(est.stats.counter("pairs-tested").unwrap() > 0);
+//!         assert!(est.stats.counter(AfsmCounter::PairsTested).unwrap() > 0);
 //!     }
 //!     // Without an adapter (and without `SHADOW_REQUIRE_GPU`), AFSM says why.
 //!     Err(e) => assert!(matches!(
@@ -59,9 +59,11 @@ pub mod params;
 pub mod passes;
 pub mod pipelines;
 pub mod sample_grid;
+pub mod statistics;
 pub mod technique;
 pub mod temporal;
 pub mod volume;
 
+pub use statistics::{AfsmCounter, AfsmGauge, AfsmPhase};
 pub use technique::{Afsm, PlaneTest, PreparedAfsm};
 pub use temporal::{TemporalAccumulator, accumulate};

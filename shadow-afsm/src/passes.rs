@@ -18,14 +18,15 @@
 //! iterations in all (llvmpipe) still compute every pair.
 //!
 //! Each phase is submitted on its own and waited for, so [`Stats`] holds per-phase GPU times
-//! (submission to completion); where the adapter has timestamp queries, counters
-//! `<phase>-device-ns` hold the device time of the phase's passes alone.
+//! (submission to completion); where the adapter has timestamp queries, each phase's
+//! `device_seconds` holds the device time of its passes alone.
 
 use shadow_core::gpu::{Encoder, GpuContext, GpuError};
 use shadow_core::technique::Stats;
 
 use crate::params::{Params, Receiver, Region};
 pub use crate::pipelines::{COMMON, MODULES, OCCUPIED, Pipelines, TALLY, TILING, VOLUME, source};
+use crate::statistics::{AfsmCounter, AfsmPhase};
 use glam::Vec3;
 
 /// A device failure as a technique error.
@@ -39,19 +40,19 @@ fn pairs_per_invocation(words: u32) -> u32 {
     (64 / words.max(1)).clamp(1, 8)
 }
 
-/// Runs phase `name` of `stats` (wall-clock time from submission to completion, readbacks
+/// Runs `phase` of `stats` (wall-clock time from submission to completion, readbacks
 /// included) and, where the device has timestamp queries, adds the device time of its passes
-/// to counter `name-device-ns` (a counter, not a phase, so phase totals stay wall-clock).
+/// to the phase's device seconds.
 fn timed<T>(
     gpu: &GpuContext,
     stats: &mut Stats,
-    name: &str,
+    phase: AfsmPhase,
     f: impl FnOnce() -> Result<T, GpuError>,
 ) -> Result<T, GpuError> {
     gpu.take_device_seconds();
-    let out = stats.time(name, f)?;
+    let out = stats.time(phase, f)?;
     if let Some(s) = gpu.take_device_seconds().filter(|s| *s > 0.0) {
-        stats.add(&format!("{name}-device-ns"), (s * 1e9).round() as u64);
+        stats.add_device_time(phase, s);
     }
     Ok(out)
 }
@@ -136,17 +137,17 @@ const TILE_SLOT: usize = 7;
 const PAIR_SLOT: usize = 8;
 /// The tallies of work skipped, kept over every range: cluster culling's (`tile_pairs.wgsl`)
 /// and the pairs whose view sample was already hidden from every light sample (`occlude.wgsl`).
-const SKIPPED_SLOTS: [(usize, &str); 10] = [
-    (9, "tiles-culled"),
-    (10, "texels-culled-by-depth"),
-    (11, "pairs-after-umbra"),
-    (12, "tiles-empty"),
-    (13, "texels-hidden"),
-    (14, "tiles-hidden"),
-    (15, "texels-culled-by-region"),
-    (16, "texels-culled-by-volume"),
-    (17, "super-tiles-culled"),
-    (18, "casters-culled"),
+const SKIPPED_SLOTS: [(usize, AfsmCounter); 10] = [
+    (9, AfsmCounter::TilesCulled),
+    (10, AfsmCounter::TexelsCulledByDepth),
+    (11, AfsmCounter::PairsAfterUmbra),
+    (12, AfsmCounter::TilesEmpty),
+    (13, AfsmCounter::TexelsHidden),
+    (14, AfsmCounter::TilesHidden),
+    (15, AfsmCounter::TexelsCulledByRegion),
+    (16, AfsmCounter::TexelsCulledByVolume),
+    (17, AfsmCounter::SuperTilesCulled),
+    (18, AfsmCounter::CastersCulled),
 ];
 /// Tallies buffer length in u32 words (nineteen 64-bit slots).
 const TALLY_WORDS: usize = 38;
@@ -201,7 +202,7 @@ impl Occlusion<'_> {
             // The stencil's edges have no penumbra volumes.
             p.options[3] = 0;
         }
-        timed(gpu, stats, "gpu-influence", || {
+        timed(gpu, stats, AfsmPhase::GpuInfluence, || {
             let uni = gpu.uniform("params", &p);
             let mut enc = gpu.encoder();
             let b = gpu.bind(
@@ -240,7 +241,7 @@ impl Occlusion<'_> {
     /// Recounts each texel's view samples hidden from every light sample (`hidden.wgsl`).
     fn refresh_hidden(&self, params: &Params, stats: &mut Stats) -> Result<(), GpuError> {
         let (gpu, pipes) = (self.gpu, self.pipes);
-        timed(gpu, stats, "gpu-hidden", || {
+        timed(gpu, stats, AfsmPhase::GpuHidden, || {
             let uni = gpu.uniform("params", params);
             let mut enc = gpu.encoder();
             enc.clear_buffer(self.texel_hidden, 0, None);
@@ -284,7 +285,7 @@ impl Occlusion<'_> {
         let mut keep = Vec::new();
         let tile_counts = gpu.storage_zeroed("tile counts", (count as u64 + 1) * 4)?;
         let caster_masks = gpu.storage_zeroed("kept super-tiles", count as u64 * 12)?;
-        let tiles = timed(gpu, stats, "gpu-tiles", || {
+        let tiles = timed(gpu, stats, AfsmPhase::GpuTiles, || {
             let uni = gpu.uniform("params", &p);
             let mut enc = gpu.encoder();
             enc.clear_buffer(self.tallies, 4 * 2 * TILE_SLOT as u64, Some(16));
@@ -307,7 +308,7 @@ impl Occlusion<'_> {
             self.tally(TILE_SLOT)
         })?;
         if let Work::Occlude(_) = work {
-            stats.add("tiles-numbered", tiles);
+            stats.add(AfsmCounter::TilesNumbered, tiles);
         }
         if tiles == 0 {
             return Ok(());
@@ -333,7 +334,7 @@ impl Occlusion<'_> {
         let batch = match work {
             Work::Occlude(batch) => batch,
             Work::Stencil => {
-                return timed(gpu, stats, "gpu-stencil", || {
+                return timed(gpu, stats, AfsmPhase::GpuStencil, || {
                     let uni = gpu.uniform("params", &p);
                     let mut enc = gpu.encoder();
                     let b = gpu.bind(
@@ -357,7 +358,7 @@ impl Occlusion<'_> {
         // are kept aside in case the range must be split and its tiles counted again.
         let pair_counts = gpu.storage_zeroed("pair counts", (3 * tiles + 1) * 4)?;
         let saved = gpu.storage_zeroed("saved tallies", TALLY_WORDS as u64 * 4)?;
-        let pairs = timed(gpu, stats, "gpu-tiles", || {
+        let pairs = timed(gpu, stats, AfsmPhase::GpuTiles, || {
             let uni = gpu.uniform("params", &p);
             let mut enc = gpu.encoder();
             enc.copy_buffer_to_buffer(self.tallies, 0, &saved, 0, TALLY_WORDS as u64 * 4);
@@ -418,7 +419,7 @@ impl Occlusion<'_> {
         }
         p.work[3] = pairs as u32;
         let groups = pairs.div_ceil(64 * pairs_per_invocation(params.dims[3]) as u64);
-        timed(gpu, stats, "gpu-occlude", || {
+        timed(gpu, stats, AfsmPhase::GpuOcclude, || {
             let uni = gpu.uniform("params", &p);
             let mut enc = gpu.encoder();
             let b = gpu.bind(
@@ -449,14 +450,14 @@ impl Occlusion<'_> {
 }
 
 /// Occlusion-pass tallies, in the order the shader keeps them.
-pub const TALLIES: [&str; 7] = [
-    "texels-visited",
-    "pairs-tested",
-    "pairs-empty",
-    "pairs-full",
-    "pairs-per-sample",
-    "pairs-own-triangle",
-    "pairs-one-sample",
+pub const TALLIES: [AfsmCounter; 7] = [
+    AfsmCounter::TexelsVisited,
+    AfsmCounter::PairsTested,
+    AfsmCounter::PairsEmpty,
+    AfsmCounter::PairsFull,
+    AfsmCounter::PairsPerSample,
+    AfsmCounter::PairsOwnTriangle,
+    AfsmCounter::PairsOneSample,
 ];
 
 /// What a batch of view samples gives back.
@@ -473,7 +474,7 @@ pub struct BatchOutput {
     /// The occlusion tallies ([`TALLIES`]).
     pub tallies: [u64; TALLIES.len()],
     /// The tallies of work skipped, named.
-    pub skipped: Vec<(&'static str, u64)>,
+    pub skipped: Vec<(AfsmCounter, u64)>,
 }
 
 /// Runs every pass for one batch of receivers; `params` holds the frame, light and sizes
@@ -501,7 +502,7 @@ pub fn run_batch(
     let mut keep = Vec::new();
     let tiles_per_side = side.div_ceil(8) as u64;
     let (rbuf, counts, slots, lists, masks, result, tallies) =
-        timed(gpu, stats, "gpu-upload", || {
+        timed(gpu, stats, AfsmPhase::GpuUpload, || {
             Ok::<_, GpuError>((
                 gpu.storage("receivers", receivers)?,
                 gpu.storage_zeroed("list counts", (texels as u64 + 1) * 4)?,
@@ -539,7 +540,7 @@ pub fn run_batch(
     let tile_hidden = gpu.storage_zeroed("hidden per tile", tiles_per_side.pow(2) * 4)?;
     let uni = gpu.uniform("params", &params);
     let groups = (n as u64).div_ceil(64);
-    timed(gpu, stats, "gpu-lists", || {
+    timed(gpu, stats, AfsmPhase::GpuLists, || {
         let mut enc = gpu.encoder();
         let b = gpu.bind(
             &pipes.count,
@@ -622,7 +623,7 @@ pub fn run_batch(
             last_regions = gpu.read::<Region>(&regions, batch.len as usize)?;
         }
     }
-    timed(gpu, stats, "gpu-resolve", || {
+    timed(gpu, stats, AfsmPhase::GpuResolve, || {
         let mut enc = gpu.encoder();
         let b = gpu.bind(
             &pipes.resolve,
@@ -639,7 +640,7 @@ pub fn run_batch(
         gpu.dispatch(&mut enc, &pipes.resolve, &b, groups)?;
         gpu.submit(enc)
     })?;
-    timed(gpu, stats, "gpu-readback", || {
+    timed(gpu, stats, AfsmPhase::GpuReadback, || {
         let t: Vec<u32> = gpu.read(&tallies, TALLY_WORDS)?;
         let word = |k: usize| t[2 * k] as u64 | (t[2 * k + 1] as u64) << 32;
         let mut tallies = [0u64; TALLIES.len()];

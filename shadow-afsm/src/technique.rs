@@ -40,6 +40,7 @@ use crate::lut::PlaneLut;
 use crate::params::{Caster, LightBounds, OPAQUE, Params, Receiver, Region};
 use crate::passes::{CasterBatch, Pipelines, Shared, TALLIES, device_error, run_batch};
 use crate::sample_grid::SampleGrid;
+use crate::statistics::{AfsmCounter, AfsmGauge, AfsmPhase};
 
 /// How the occlusion pass finds the samples behind a plane (section 4.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -277,7 +278,7 @@ impl Afsm {
         self.capabilities()
             .require(&self.name, scene.as_ref(), light.as_ref())?;
         let mut stats = Stats::default();
-        let p = stats.time("prepare", || self.build(scene, light))?;
+        let p = stats.time(AfsmPhase::Prepare, || self.build(scene, light))?;
         Ok(PreparedAfsm {
             config: self.clone(),
             p,
@@ -512,7 +513,7 @@ impl Afsm {
         let words = self.words();
         let textured = p.light.is_textured() && !self.hard;
         // Receivers: light front-facing view samples (section 3).
-        let (receivers, pixels, facing_away) = stats.time("receivers", || {
+        let (receivers, pixels, facing_away) = stats.time(AfsmPhase::Receivers, || {
             let mut r = Vec::new();
             let mut px = Vec::new();
             let mut away = 0u64;
@@ -588,7 +589,10 @@ impl Afsm {
         let separating = view.eye().map_or(0, |e| {
             crate::inputs::closed_meshes_between(p.scene.as_ref(), &p.closed, &p.around_light, e)
         });
-        stats.add("closed-meshes-between-eye-and-light", separating as u64);
+        stats.add(
+            AfsmCounter::ClosedMeshesBetweenEyeAndLight,
+            separating as u64,
+        );
         let casters: &[CasterBatch] = if separating > 0 {
             let open = p.open_batches.get_or_init(|| {
                 let all_open = vec![false; p.closed.len()];
@@ -608,8 +612,8 @@ impl Afsm {
         let mut stages = Vec::new();
         let (mut occupied, mut longest, mut batches) = (0u64, 0u64, 0u64);
         let mut tallies = [0u64; TALLIES.len()];
-        let mut skipped: Vec<(&str, u64)> = Vec::new();
-        let groups = stats.time("frame", || {
+        let mut skipped: Vec<(AfsmCounter, u64)> = Vec::new();
+        let groups = stats.time(AfsmPhase::Frame, || {
             group_receivers(p.bounds.center, &receivers, &pixels, per_batch, side)
         });
         for (chunk, chunk_px, frame) in groups {
@@ -694,16 +698,16 @@ impl Afsm {
             words: bits,
         })?;
         vis.validate()?;
-        stats.add("receivers-listed", receivers.len() as u64);
-        stats.add("receivers-facing-away", facing_away);
-        stats.add("receiver-batches", batches);
-        stats.add("caster-batches", casters.len() as u64);
-        stats.add("silhouette-edges", p.silhouette_count as u64);
-        stats.add("lists-occupied", occupied);
-        stats.gauge_max("list-length-max", longest);
-        stats.gauge_max("map-side", side as u64);
-        for (k, name) in TALLIES.iter().enumerate() {
-            stats.add(name, tallies[k]);
+        stats.add(AfsmCounter::ReceiversListed, receivers.len() as u64);
+        stats.add(AfsmCounter::ReceiversFacingAway, facing_away);
+        stats.add(AfsmCounter::ReceiverBatches, batches);
+        stats.add(AfsmCounter::CasterBatches, casters.len() as u64);
+        stats.add(AfsmCounter::SilhouetteEdges, p.silhouette_count as u64);
+        stats.add(AfsmCounter::ListsOccupied, occupied);
+        stats.gauge_max(AfsmGauge::ListLengthMax, longest);
+        stats.gauge_max(AfsmGauge::MapSide, side as u64);
+        for (k, counter) in TALLIES.iter().enumerate() {
+            stats.add(*counter, tallies[k]);
         }
         for (name, v) in skipped {
             stats.add(name, v);

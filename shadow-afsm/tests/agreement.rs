@@ -6,6 +6,7 @@
 use std::sync::Arc;
 
 use shadow_afsm::Afsm;
+use shadow_afsm::statistics::{AfsmCounter, AfsmGauge};
 use shadow_core::gpu::context_for_test;
 use shadow_core::prelude::*;
 use shadow_io::SceneSetup;
@@ -53,13 +54,13 @@ fn soft_shadows_agree_with_the_same_samples_reference_on_every_scene() {
             "{name:<22} agreement {a:.6} rmse {:.5} max {:.3} lists {} longest {} pairs {} full {} per-sample {} one-sample {} silhouettes {}",
             m.rmse,
             m.max_abs,
-            est.stats.counter("lists-occupied").unwrap(),
-            est.stats.gauge("list-length-max").unwrap(),
-            est.stats.counter("pairs-tested").unwrap(),
-            est.stats.counter("pairs-full").unwrap(),
-            est.stats.counter("pairs-per-sample").unwrap(),
-            est.stats.counter("pairs-one-sample").unwrap(),
-            est.stats.counter("silhouette-edges").unwrap(),
+            est.stats.counter(AfsmCounter::ListsOccupied).unwrap(),
+            est.stats.gauge(AfsmGauge::ListLengthMax).unwrap(),
+            est.stats.counter(AfsmCounter::PairsTested).unwrap(),
+            est.stats.counter(AfsmCounter::PairsFull).unwrap(),
+            est.stats.counter(AfsmCounter::PairsPerSample).unwrap(),
+            est.stats.counter(AfsmCounter::PairsOneSample).unwrap(),
+            est.stats.counter(AfsmCounter::SilhouetteEdges).unwrap(),
         );
         if a < 0.999 {
             failures.push(format!("{name}: agreement {a}"));
@@ -167,11 +168,15 @@ fn gpu_stages_equal_their_cpu_computation() {
             "{name}: every receiver in one list"
         );
         assert_eq!(
-            est.stats.counter("texels-visited").unwrap(),
+            est.stats.counter(AfsmCounter::TexelsVisited).unwrap(),
             texels,
             "{name}"
         );
-        assert_eq!(est.stats.counter("pairs-tested").unwrap(), pairs, "{name}");
+        assert_eq!(
+            est.stats.counter(AfsmCounter::PairsTested).unwrap(),
+            pairs,
+            "{name}"
+        );
         println!("{name:<20} texels visited {texels}, pairs tested {pairs}");
     }
 }

@@ -12,6 +12,7 @@
 use std::sync::Arc;
 
 use shadow_afsm::Afsm;
+use shadow_afsm::statistics::AfsmCounter;
 use shadow_core::gpu::context_for_test;
 use shadow_core::prelude::*;
 use shadow_metrics::compare;
@@ -49,47 +50,51 @@ fn cluster_culling_changes_no_bit_and_tests_fewer_pairs() {
         };
         let (culled, plain) = (run(true), run(false));
         let m = compare(&culled.visibility, &plain.visibility).unwrap();
-        let count = |e: &Estimate, k: &str| e.stats.counter(k).expect("AFSM counts it");
+        let count = |e: &Estimate, k: AfsmCounter| e.stats.counter(k).expect("AFSM counts it");
         println!(
             "{name:<18} pairs tested {} -> {}, tiles culled {}, texels culled by depth {}, \
              texels hidden {}, texels culled by volume {}, empty pairs {}, agreement {:.7}",
-            count(&plain, "pairs-tested"),
-            count(&culled, "pairs-tested"),
-            count(&culled, "tiles-culled"),
-            count(&culled, "texels-culled-by-depth"),
-            count(&culled, "texels-hidden"),
-            count(&culled, "texels-culled-by-volume"),
-            count(&culled, "pairs-empty"),
+            count(&plain, AfsmCounter::PairsTested),
+            count(&culled, AfsmCounter::PairsTested),
+            count(&culled, AfsmCounter::TilesCulled),
+            count(&culled, AfsmCounter::TexelsCulledByDepth),
+            count(&culled, AfsmCounter::TexelsHidden),
+            count(&culled, AfsmCounter::TexelsCulledByVolume),
+            count(&culled, AfsmCounter::PairsEmpty),
             m.sample_agreement.unwrap()
         );
         assert_eq!(m.sample_agreement, Some(1.0), "{name}: {m:?}");
         assert_eq!(m.max_abs, 0.0, "{name}");
-        assert_eq!(count(&plain, "tiles-culled"), 0, "{name}");
+        assert_eq!(count(&plain, AfsmCounter::TilesCulled), 0, "{name}");
         assert!(
-            count(&culled, "pairs-tested") <= count(&plain, "pairs-tested"),
+            count(&culled, AfsmCounter::PairsTested) <= count(&plain, AfsmCounter::PairsTested),
             "{name}"
         );
-        fewer_somewhere |= count(&culled, "pairs-tested") * 2 < count(&plain, "pairs-tested");
+        fewer_somewhere |=
+            count(&culled, AfsmCounter::PairsTested) * 2 < count(&plain, AfsmCounter::PairsTested);
         if name.starts_with("interior") || name == "bunny" {
-            assert!(count(&culled, "texels-culled-by-volume") > 0, "{name}");
+            assert!(
+                count(&culled, AfsmCounter::TexelsCulledByVolume) > 0,
+                "{name}"
+            );
         }
         if name.starts_with("interior") {
             // Whole super-tiles of the rooms' walls lie outside most casters' volumes, and
             // each cube face's view samples outside most of the room's.
-            assert!(count(&culled, "super-tiles-culled") > 0, "{name}");
-            assert!(count(&culled, "casters-culled") > 0, "{name}");
+            assert!(count(&culled, AfsmCounter::SuperTilesCulled) > 0, "{name}");
+            assert!(count(&culled, AfsmCounter::CastersCulled) > 0, "{name}");
         }
-        assert_eq!(count(&plain, "super-tiles-culled"), 0, "{name}");
-        assert_eq!(count(&plain, "casters-culled"), 0, "{name}");
+        assert_eq!(count(&plain, AfsmCounter::SuperTilesCulled), 0, "{name}");
+        assert_eq!(count(&plain, AfsmCounter::CastersCulled), 0, "{name}");
         if name == "interior" {
             // Measured 0.28 at 128x96 (issue 48 asks for below one half).
-            let empty = count(&culled, "pairs-empty") as f64;
-            let share = empty / count(&culled, "pairs-tested") as f64;
+            let empty = count(&culled, AfsmCounter::PairsEmpty) as f64;
+            let share = empty / count(&culled, AfsmCounter::PairsTested) as f64;
             assert!(share < 0.5, "{name}: {share:.3} of the tested pairs empty");
         }
         if name == "grass" {
-            assert!(count(&culled, "texels-hidden") > 0, "{name}");
-            assert_eq!(count(&plain, "texels-hidden"), 0, "{name}");
+            assert!(count(&culled, AfsmCounter::TexelsHidden) > 0, "{name}");
+            assert_eq!(count(&plain, AfsmCounter::TexelsHidden), 0, "{name}");
         }
     }
     assert!(

@@ -4,6 +4,7 @@
 use std::sync::Arc;
 
 use glam::Vec3;
+use shadow_afsm::statistics::{AfsmCounter, AfsmPhase};
 use shadow_afsm::{Afsm, accumulate};
 use shadow_core::gpu::context_for_test;
 use shadow_core::prelude::*;
@@ -102,8 +103,8 @@ fn splitting_under_a_memory_limit_changes_nothing() {
     };
     let whole = run(None);
     let split = run(Some(16 * 1024));
-    assert!(split.stats.counter("receiver-batches").unwrap() > 1);
-    assert!(split.stats.counter("caster-batches").unwrap() > 1);
+    assert!(split.stats.counter(AfsmCounter::ReceiverBatches).unwrap() > 1);
+    assert!(split.stats.counter(AfsmCounter::CasterBatches).unwrap() > 1);
     let m = compare(&split.visibility, &whole.visibility).unwrap();
     assert!(m.sample_agreement.unwrap() >= 0.9999, "{m:?}");
 }
@@ -212,22 +213,23 @@ fn silhouette_stencil_changes_no_bit_and_skips_umbra_work() {
     let (restricted, _) = run(true);
     let m = compare(&restricted.visibility, &plain.visibility).unwrap();
     let t = compare(&restricted.visibility, &truth).unwrap();
-    let count = |e: &Estimate, k: &str| e.stats.counter(k).expect("AFSM counts it");
+    let count = |e: &Estimate, k: AfsmCounter| e.stats.counter(k).expect("AFSM counts it");
     println!(
         "silhouette edges {} of the sphere's; per-sample pairs {} -> {}, one-sample pairs {}; \
          agreement with the plain run {:.6}, with the reference {:.6}",
-        count(&restricted, "silhouette-edges"),
-        count(&plain, "pairs-per-sample"),
-        count(&restricted, "pairs-per-sample"),
-        count(&restricted, "pairs-one-sample"),
+        count(&restricted, AfsmCounter::SilhouetteEdges),
+        count(&plain, AfsmCounter::PairsPerSample),
+        count(&restricted, AfsmCounter::PairsPerSample),
+        count(&restricted, AfsmCounter::PairsOneSample),
         m.sample_agreement.unwrap(),
         t.sample_agreement.unwrap(),
     );
-    assert_eq!(count(&plain, "pairs-one-sample"), 0);
-    assert!(count(&restricted, "pairs-one-sample") > 0);
+    assert_eq!(count(&plain, AfsmCounter::PairsOneSample), 0);
+    assert!(count(&restricted, AfsmCounter::PairsOneSample) > 0);
     // Measured: 1904 -> 1214 per-sample pairs (690 one-sample).
     assert!(
-        count(&restricted, "pairs-per-sample") * 4 < count(&plain, "pairs-per-sample") * 3,
+        count(&restricted, AfsmCounter::PairsPerSample) * 4
+            < count(&plain, AfsmCounter::PairsPerSample) * 3,
         "the stencil should cut the per-sample work by a quarter or more here"
     );
     assert!(m.sample_agreement.unwrap() >= 0.9999, "{m:?}");
@@ -424,22 +426,19 @@ fn device_times_from_timestamp_queries_fit_inside_their_phases() {
         .estimate(&view, Outputs::VISIBILITY)
         .unwrap();
     for phase in [
-        "gpu-lists",
-        "gpu-influence",
-        "gpu-tiles",
-        "gpu-occlude",
-        "gpu-resolve",
+        AfsmPhase::GpuLists,
+        AfsmPhase::GpuInfluence,
+        AfsmPhase::GpuTiles,
+        AfsmPhase::GpuOcclude,
+        AfsmPhase::GpuResolve,
     ] {
         let wall = est.stats.phase_seconds(phase).expect("phase ran");
         let device = est
             .stats
-            .counter(&format!("{phase}-device-ns"))
-            .unwrap_or_else(|| panic!("{phase}: no device time"));
-        println!(
-            "{phase}: wall {wall:.5} s, device {:.5} s",
-            device as f64 * 1e-9
-        );
-        assert!(device > 0, "{phase}");
-        assert!(device as f64 * 1e-9 <= wall * 1.01 + 1e-4, "{phase}");
+            .device_seconds(phase)
+            .unwrap_or_else(|| panic!("{phase:?}: no device time"));
+        println!("{phase:?}: wall {wall:.5} s, device {device:.5} s");
+        assert!(device > 0.0, "{phase:?}");
+        assert!(device <= wall * 1.01 + 1e-4, "{phase:?}");
     }
 }

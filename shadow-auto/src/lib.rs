@@ -35,6 +35,7 @@
 
 pub mod model;
 pub mod probe;
+pub mod statistics;
 
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
@@ -52,6 +53,7 @@ pub use model::{
 };
 pub use probe::ProbeKind;
 use probe::{Probe, probe_features, probe_reference};
+pub use statistics::{AutoCounter, AutoPhase};
 
 /// Under a time budget a pick must fit `TIME_MARGIN` times its predicted time: the 0.9
 /// quantile of achieved over predicted time of `auto`'s picks under time budgets on scenes the
@@ -175,8 +177,11 @@ impl ShadowTechnique for Auto {
             }
         }
         let mut stats = Stats::default();
-        stats.add_time("auto-probe-prepare", probe_prepare);
-        stats.add("auto-probe-dcs", u64::from(probe.kind() == ProbeKind::Dcs));
+        stats.add_time(AutoPhase::AutoProbePrepare, probe_prepare);
+        stats.add(
+            AutoCounter::AutoProbeDcs,
+            u64::from(probe.kind() == ProbeKind::Dcs),
+        );
         Ok(Box::new(PreparedAuto {
             config: self.clone(),
             scene,
@@ -238,6 +243,28 @@ pub struct Decision {
     pub speed_ratio: f64,
     /// Every candidate considered, with its prediction.
     pub candidates: Vec<Prediction>,
+}
+
+impl Decision {
+    /// The decision `auto` made for `estimate`, `None` for another technique's estimate.
+    pub fn of(estimate: &Estimate) -> Option<&Decision> {
+        estimate.decision.as_ref()?.as_any().downcast_ref()
+    }
+}
+
+impl EstimateDecision for Decision {
+    fn choice(&self) -> &str {
+        &self.choice
+    }
+    fn reason(&self) -> &str {
+        &self.reason
+    }
+    fn to_json(&self) -> serde_json::Value {
+        serde_json::to_value(self).unwrap_or(serde_json::Value::Null)
+    }
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
 }
 
 impl PreparedAuto {
@@ -493,10 +520,10 @@ impl PreparedShadows for PreparedAuto {
         let prepare_seconds = t1.elapsed().as_secs_f64();
         let mut est = prepared.estimate(view, outputs)?;
         let mut stats = Stats::default();
-        stats.add_time("auto-probe", probe_seconds);
-        stats.add_time("auto-chosen-prepare", prepare_seconds);
+        stats.add_time(AutoPhase::AutoProbe, probe_seconds);
+        stats.add_time(AutoPhase::AutoChosenPrepare, prepare_seconds);
         stats.merge(&est.stats);
-        stats.add("auto-probe-pixels", features.probe_pixels as u64);
+        stats.add(AutoCounter::AutoProbePixels, features.probe_pixels as u64);
         // The chosen configuration on the probe's own preparation: DCS's edges, silhouettes
         // and wedges, or the reference's BVH.
         let reused = matches!(
@@ -507,10 +534,13 @@ impl PreparedShadows for PreparedAuto {
                     ProbeKind::Reference
                 )
         );
-        stats.add("auto-probe-preparation-reused", u64::from(reused));
-        stats.add("auto-candidates", decision.candidates.len() as u64);
+        stats.add(AutoCounter::AutoProbePreparationReused, u64::from(reused));
+        stats.add(
+            AutoCounter::AutoCandidates,
+            decision.candidates.len() as u64,
+        );
         est.stats = stats;
-        est.decision = serde_json::to_value(&decision).unwrap_or(serde_json::Value::Null);
+        est.decision = Some(Arc::new(decision));
         Ok(est)
     }
 

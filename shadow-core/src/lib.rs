@@ -78,6 +78,7 @@ mod rounding;
 pub mod sampling;
 pub mod scene;
 pub mod spatial_order;
+pub mod stats;
 pub mod technique;
 pub mod topology;
 pub mod triangulate;
@@ -104,8 +105,8 @@ pub mod prelude {
     pub use crate::sampling::{LightSampler, SamplingStrategy};
     pub use crate::scene::{MeshDesc, Scene, SceneBuilder, TriangleScene};
     pub use crate::technique::{
-        Capabilities, Estimate, Outputs, PreparedShadows, Processor, SceneRef, ShadowTechnique,
-        Stats, TechniqueError, UnsupportedReason,
+        Capabilities, Estimate, EstimateDecision, Outputs, PreparedShadows, Processor, SceneRef,
+        ShadowTechnique, Stats, TechniqueError, UnsupportedReason,
     };
     pub use crate::view_samples::ViewSamples;
     pub use crate::visibility::{

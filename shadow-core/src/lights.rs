@@ -18,6 +18,7 @@
 use glam::Vec3;
 
 use crate::light::Light;
+use crate::stats::CoreCounter;
 use crate::technique::{
     Estimate, Outputs, PreparedShadows, SceneRef, ShadowTechnique, Stats, TechniqueError,
     UnsupportedReason,
@@ -103,7 +104,7 @@ impl PreparedLights {
                     let prepared = f
                         .prepare(scene.clone(), light.clone())
                         .map_err(|e| TechniqueError::for_light(index, e))?;
-                    preparation.add("lights-fallback", 1);
+                    preparation.add(CoreCounter::LightsFallback, 1);
                     PreparedLight {
                         light: light.clone(),
                         prepared,
@@ -153,14 +154,14 @@ impl PreparedLights {
         for (index, p) in self.lights.iter().enumerate() {
             let skipped = !reaches_any_receiver(&p.light, view);
             let estimate = if skipped {
-                stats.add("lights-skipped", 1);
+                stats.add(CoreCounter::LightsSkipped, 1);
                 p.prepared
                     .check_outputs(outputs)
                     .map_err(|e| TechniqueError::for_light(index, e))?;
                 dark_estimate(view, &p.light, outputs, p.samples)
                     .map_err(|e| TechniqueError::for_light(index, e))?
             } else {
-                stats.add("lights-shadowed", 1);
+                stats.add(CoreCounter::LightsShadowed, 1);
                 p.prepared
                     .estimate(view, outputs)
                     .map_err(|e| TechniqueError::for_light(index, e))?
@@ -218,7 +219,7 @@ fn dark_estimate(
         visibility.set_per_sample(PerSampleVisibility::bits(view.len(), n))?;
     }
     let mut stats = Stats::default();
-    stats.add("pixels-behind-light", view.valid_count() as u64);
+    stats.add(CoreCounter::PixelsBehindLight, view.valid_count() as u64);
     let mut estimate = Estimate::new(visibility, stats);
     estimate.direct = outputs.direct.then(|| vec![Vec3::ZERO; view.len()]);
     Ok(estimate)

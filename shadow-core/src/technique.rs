@@ -1,9 +1,7 @@
 //! The object-safe [`ShadowTechnique`] trait every technique implements, its capabilities, its
 //! statistics and its error type (DESIGN section 3).
 
-use std::collections::BTreeMap;
 use std::sync::Arc;
-use std::time::Instant;
 
 use glam::Vec3;
 use serde::Serialize;
@@ -13,6 +11,8 @@ use crate::light::{AreaLight, Light, LightKind, LightSample};
 use crate::raster::RasterError;
 use crate::sampling::LightSampler;
 use crate::scene::Scene;
+use crate::stats::{CoreCounter, CorePhase};
+pub use crate::stats::{Phase, Stats};
 use crate::view_samples::{ViewSample, ViewSamples};
 use crate::visibility::{VisibilityError, VisibilityImage};
 
@@ -245,115 +245,6 @@ impl Capabilities {
     }
 }
 
-/// Time of one phase.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Phase {
-    /// Phase name.
-    pub name: String,
-    /// Wall-clock seconds.
-    pub seconds: f64,
-}
-
-/// Per-phase times, counters of work done and skipped, and gauges.
-///
-/// Counters are amounts (rays, pixels, pairs): they add up when stats merge, saturate at
-/// `u64::MAX` and record the saturation in `saturated`, so they never wrap silently. Gauges are
-/// levels (a largest value, a width chosen, a map's side): merging keeps the larger. Looking a
-/// name up gives `None` when it was never recorded, so a test on a renamed counter fails.
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
-pub struct Stats {
-    /// Phases in the order they ran.
-    pub phases: Vec<Phase>,
-    /// Named counters.
-    pub counters: BTreeMap<String, u64>,
-    /// Named gauges.
-    pub gauges: BTreeMap<String, u64>,
-    /// Counters that saturated.
-    pub saturated: Vec<String>,
-}
-
-impl Stats {
-    /// Runs `f`, adding its wall-clock time to phase `name`.
-    pub fn time<T>(&mut self, name: &str, f: impl FnOnce() -> T) -> T {
-        let t0 = Instant::now();
-        let r = f();
-        self.add_time(name, t0.elapsed().as_secs_f64());
-        r
-    }
-
-    /// Adds `seconds` to phase `name`.
-    pub fn add_time(&mut self, name: &str, seconds: f64) {
-        match self.phases.iter_mut().find(|p| p.name == name) {
-            Some(p) => p.seconds += seconds,
-            None => self.phases.push(Phase {
-                name: name.to_string(),
-                seconds,
-            }),
-        }
-    }
-
-    /// Adds `n` to counter `name`, saturating (and recording it) on overflow.
-    pub fn add(&mut self, name: &str, n: u64) {
-        let c = self.counters.entry(name.to_string()).or_insert(0);
-        match c.checked_add(n) {
-            Some(v) => *c = v,
-            None => {
-                *c = u64::MAX;
-                if !self.saturated.iter().any(|s| s == name) {
-                    self.saturated.push(name.to_string());
-                }
-            }
-        }
-    }
-
-    /// Raises gauge `name` to `v` (a gauge keeps the largest value recorded).
-    pub fn gauge_max(&mut self, name: &str, v: u64) {
-        let g = self.gauges.entry(name.to_string()).or_insert(v);
-        *g = (*g).max(v);
-    }
-
-    /// Total time over all phases.
-    pub fn total_seconds(&self) -> f64 {
-        self.phases.iter().map(|p| p.seconds).sum()
-    }
-
-    /// Seconds of phase `name`, when it ran.
-    pub fn phase_seconds(&self, name: &str) -> Option<f64> {
-        self.phases
-            .iter()
-            .find(|p| p.name == name)
-            .map(|p| p.seconds)
-    }
-
-    /// Merges another set of stats: times and counters add up, gauges keep the larger.
-    pub fn merge(&mut self, other: &Stats) {
-        for p in &other.phases {
-            self.add_time(&p.name, p.seconds);
-        }
-        for (k, v) in &other.counters {
-            self.add(k, *v);
-        }
-        for (k, v) in &other.gauges {
-            self.gauge_max(k, *v);
-        }
-        for s in &other.saturated {
-            if !self.saturated.contains(s) {
-                self.saturated.push(s.clone());
-            }
-        }
-    }
-
-    /// Counter `name`, or `None` when it was never recorded.
-    pub fn counter(&self, name: &str) -> Option<u64> {
-        self.counters.get(name).copied()
-    }
-
-    /// Gauge `name`, or `None` when it was never recorded.
-    pub fn gauge(&self, name: &str) -> Option<u64> {
-        self.gauges.get(name).copied()
-    }
-}
-
 /// What a caller wants from an estimate beyond `V(p)`.
 ///
 /// Asking only for what is read saves memory and time: per-sample visibility is
@@ -393,10 +284,10 @@ pub struct Estimate {
     pub direct: Option<Vec<Vec3>>,
     /// Times and counters of this estimate.
     pub stats: Stats,
-    /// What the technique decided at estimate time, for reports (`stats.json`): the `auto`
-    /// chooser's choice, its reason and its prediction. `Null` for techniques that decide
-    /// nothing per view.
-    pub decision: serde_json::Value,
+    /// What the technique decided at estimate time (the `auto` chooser's choice, its reason
+    /// and its prediction); `None` for techniques that decide nothing per view. Read the
+    /// concrete type with [`EstimateDecision::as_any`].
+    pub decision: Option<Arc<dyn EstimateDecision>>,
 }
 
 impl Estimate {
@@ -406,7 +297,7 @@ impl Estimate {
             visibility,
             direct: None,
             stats,
-            decision: serde_json::Value::Null,
+            decision: None,
         }
     }
 }
@@ -432,8 +323,24 @@ impl Estimate {
                 count += 1;
             }
         }
-        self.stats.add("pixels-behind-light", count);
+        self.stats.add(CoreCounter::PixelsBehindLight, count);
     }
+}
+
+/// What a technique decided at estimate time: a configuration chosen for this view, and why.
+///
+/// The technique's own type holds the rest (`shadow_auto::Decision` holds the predictions);
+/// a caller that knows it reads it with [`EstimateDecision::as_any`], a report reads the
+/// choice, the reason and [`EstimateDecision::to_json`].
+pub trait EstimateDecision: std::fmt::Debug + Send + Sync + std::any::Any {
+    /// The configuration chosen, by preset name.
+    fn choice(&self) -> &str;
+    /// Why it was chosen.
+    fn reason(&self) -> &str;
+    /// The whole decision for `stats.json`.
+    fn to_json(&self) -> serde_json::Value;
+    /// The decision as [`std::any::Any`], to downcast to the technique's type.
+    fn as_any(&self) -> &dyn std::any::Any;
 }
 
 /// A soft-shadow technique: a configuration that prepares a scene and light.
@@ -563,7 +470,8 @@ pub fn finish_estimate<P: PreparedShadows + ?Sized>(
         let t0 = std::time::Instant::now();
         let direct = prepared.direct_light(view, &est)?;
         est.direct = Some(direct);
-        est.stats.add_time("direct", t0.elapsed().as_secs_f64());
+        est.stats
+            .add_time(CorePhase::Direct, t0.elapsed().as_secs_f64());
     }
     est.darken_behind_light(view, prepared.light());
     est.visibility.validate()?;
@@ -673,32 +581,6 @@ fn shade_from_per_sample(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn counters_saturate_and_report() {
-        let mut s = Stats::default();
-        s.add("rays", u64::MAX - 1);
-        s.add("rays", 5);
-        assert_eq!(s.counter("rays"), Some(u64::MAX));
-        assert_eq!(s.counter("ray"), None);
-        assert_eq!(s.saturated, vec!["rays".to_string()]);
-        let v = s.time("phase", || 3);
-        assert_eq!(v, 3);
-        assert_eq!(s.phases.len(), 1);
-    }
-
-    #[test]
-    fn gauges_keep_the_largest_value_on_merge() {
-        let (mut a, mut b) = (Stats::default(), Stats::default());
-        a.gauge_max("counter-bits", 16);
-        a.add("pixels", 3);
-        b.gauge_max("counter-bits", 8);
-        b.add("pixels", 4);
-        a.merge(&b);
-        assert_eq!(a.gauge("counter-bits"), Some(16));
-        assert_eq!(a.counter("pixels"), Some(7));
-        assert_eq!(a.counter("counter-bits"), None);
-    }
 
     #[test]
     fn unsupported_reasons_read_as_before() {

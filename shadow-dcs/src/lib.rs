@@ -60,14 +60,14 @@
 //!
 //! ```
 //! use shadow_core::prelude::*;
-//! use shadow_dcs::Dcs;
+//! use shadow_dcs::{Dcs, DcsCounter};
 //!
 //! let setup = shadow_scenes::builtin("quad-over-plane").unwrap();
 //! let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 32, 24).unwrap();
 //! let dcs = Dcs::new(16, SamplingStrategy::Stratified, 1).unwrap();
 //! let prepared = dcs.prepare(setup.scene.clone(), setup.lights[0].clone()).unwrap();
 //! let est = prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
-//! assert!(est.stats.counter("wedge-pairs").unwrap() > 0);
+//! assert!(est.stats.counter(DcsCounter::WedgePairs).unwrap() > 0);
 //! ```
 
 #![deny(missing_docs)]
@@ -75,8 +75,10 @@
 mod accel;
 pub mod paper;
 pub mod stages;
+pub mod statistics;
 pub mod technique;
 
 pub use stages::discrete::{self, CoveredSamples};
 pub use stages::edges::{self, Silhouettes};
+pub use statistics::{DcsCounter, DcsGauge, DcsPhase};
 pub use technique::{Dcs, PerSampleOutput, PreparedDcs, RayChoice};

@@ -5,6 +5,7 @@
 use glam::{DVec3, Vec3};
 use shadow_core::prelude::*;
 use shadow_core::visibility::PerSampleVisibility;
+use shadow_dcs::statistics::{DcsCounter, DcsGauge};
 use shadow_dcs::{CoveredSamples, Dcs, PerSampleOutput, Silhouettes};
 use shadow_io::SceneSetup;
 use shadow_metrics::compare;
@@ -118,8 +119,8 @@ fn narrow_counters_overflow_into_wider_ones_without_changing_the_answer() {
     let est = narrow_prepared
         .estimate(&view, Outputs::VISIBILITY)
         .unwrap();
-    assert!(est.stats.counter("counter-escalations").unwrap() > 0);
-    assert!(est.stats.gauge("max-integration-constant").unwrap() >= 300);
+    assert!(est.stats.counter(DcsCounter::CounterEscalations).unwrap() > 0);
+    assert!(est.stats.gauge(DcsGauge::MaxIntegrationConstant).unwrap() >= 300);
     let Some(PerSampleVisibility::Counters { counts, .. }) = est.visibility.per_sample() else {
         panic!("counters requested")
     };
@@ -139,7 +140,7 @@ fn narrow_counters_overflow_into_wider_ones_without_changing_the_answer() {
         .with_counter_bits(8);
     let bits_prepared = bits.prepare(scene.clone(), light.clone()).unwrap();
     let est = bits_prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
-    assert!(est.stats.counter("counter-escalations").unwrap() > 0);
+    assert!(est.stats.counter(DcsCounter::CounterEscalations).unwrap() > 0);
     let m = compare(&est.visibility, &truth).unwrap();
     assert_eq!(m.sample_agreement, Some(1.0));
 }
@@ -225,11 +226,11 @@ fn every_number_of_sample_words_agrees_with_the_reference() {
         assert!(m.sample_agreement.unwrap() >= 0.9999, "{n} samples: {m:?}");
         // The pixels took per-sample work, through the light-plane test.
         assert!(
-            d.stats.counter("pixels-per-sample").unwrap() > 50,
+            d.stats.counter(DcsCounter::PixelsPerSample).unwrap() > 50,
             "{n} samples"
         );
         assert!(
-            d.stats.counter("covered-updates").unwrap() > 500,
+            d.stats.counter(DcsCounter::CoveredUpdates).unwrap() > 500,
             "{n} samples"
         );
     }
@@ -275,7 +276,7 @@ fn concave_polygon_lights_and_every_sampling_strategy_agree_with_the_reference()
         );
         let m = compare(&d.visibility, &e.visibility).unwrap();
         assert!(m.sample_agreement.unwrap() >= 0.9999, "{strategy:?}: {m:?}");
-        assert!(d.stats.counter("wedge-pairs").unwrap() > 0);
+        assert!(d.stats.counter(DcsCounter::WedgePairs).unwrap() > 0);
     }
 }
 
@@ -327,14 +328,14 @@ fn refined_tables_give_the_exact_depth_complexity() {
         // part on a sample lying on an edge's line, where a room's walls meet the light's
         // plane (`interior-window`: 2 of 33 948 updates, and no count, asserted above).
         let (ur, ue) = (
-            r.stats.counter("covered-updates").unwrap(),
-            e.stats.counter("covered-updates").unwrap(),
+            r.stats.counter(DcsCounter::CoveredUpdates).unwrap(),
+            e.stats.counter(DcsCounter::CoveredUpdates).unwrap(),
         );
         assert!(
             ur.abs_diff(ue) * 10_000 <= ue,
             "{name}: {ur} against {ue} updates"
         );
-        cells += r.stats.counter("refined-line-cells").unwrap();
+        cells += r.stats.counter(DcsCounter::RefinedLineCells).unwrap();
         scenes += 1;
     }
     assert!(scenes >= 8, "{scenes} scenes");

@@ -8,6 +8,7 @@ use std::sync::Arc;
 
 use shadow_core::prelude::*;
 use shadow_core::visibility::PerSampleVisibility;
+use shadow_dcs::statistics::DcsCounter;
 use shadow_dcs::{Dcs, PerSampleOutput, RayChoice};
 use shadow_io::SceneSetup;
 use shadow_ref::{BvhRays, Reference};
@@ -75,15 +76,15 @@ fn tracing_every_square_gives_the_answers_of_dcs_and_the_reference() {
                 "{scene}: {x} vs {y}"
             );
         }
-        let c = |k: &str| h.stats.counter(k).unwrap_or(0);
-        assert_eq!(c("shadow-volumes-skipped"), 1, "{scene}");
-        assert_eq!(c("pixels-per-sample"), 0, "{scene}");
+        let c = |k: DcsCounter| h.stats.counter(k).unwrap_or(0);
+        assert_eq!(c(DcsCounter::ShadowVolumesSkipped), 1, "{scene}");
+        assert_eq!(c(DcsCounter::PixelsPerSample), 0, "{scene}");
         assert_eq!(
-            c("pixels-traced") + c("pixels-facing-away"),
+            c(DcsCounter::PixelsTraced) + c(DcsCounter::PixelsFacingAway),
             view.valid_count() as u64,
             "{scene}"
         );
-        assert!(c("occlusion-rays") > 0, "{scene}");
+        assert!(c(DcsCounter::OcclusionRays) > 0, "{scene}");
     }
 }
 
@@ -103,12 +104,12 @@ fn the_measured_choice_traces_grass_and_not_bunny() {
         let r = run(&reference, &setup, &view, BITS);
         let m = shadow_metrics::compare(&h.visibility, &r.visibility).unwrap();
         assert!(m.sample_agreement.unwrap() >= 0.9999, "{scene}: {m:?}");
-        let squares = h.stats.counter("squares-traced").unwrap();
+        let squares = h.stats.counter(DcsCounter::SquaresTraced).unwrap();
         assert_eq!(squares > 0, traced, "{scene}: {squares} squares traced");
         // The choice weighed what it says: DCS's predicted work against the rays and the BVH.
-        let c = |k: &str| h.stats.counter(k).unwrap();
-        let dcs_work = c("predicted-dcs-rays") + c("predicted-shadow-volume-rays");
-        let rays = c("predicted-traced-rays") + c("predicted-bvh-rays");
+        let c = |k: DcsCounter| h.stats.counter(k).unwrap();
+        let dcs_work = c(DcsCounter::PredictedDcsRays) + c(DcsCounter::PredictedShadowVolumeRays);
+        let rays = c(DcsCounter::PredictedTracedRays) + c(DcsCounter::PredictedBvhRays);
         assert_eq!(
             rays < dcs_work,
             traced,
@@ -144,7 +145,11 @@ fn rays_stay_out_of_semi_opaque_scenes_and_depth_complexities() {
             BITS,
         );
         let d = run(&dcs, &setup, &view, BITS);
-        assert_eq!(h.stats.counter("squares-traced"), Some(0), "{scene}");
+        assert_eq!(
+            h.stats.counter(DcsCounter::SquaresTraced),
+            Some(0),
+            "{scene}"
+        );
         let (hv, dv) = (&h.visibility, &d.visibility);
         assert_eq!(hv.coefficients(), dv.coefficients(), "{scene}");
         if output == PerSampleOutput::Counters {

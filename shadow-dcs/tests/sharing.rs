@@ -6,6 +6,7 @@
 
 use shadow_core::prelude::*;
 use shadow_core::sampling::SamplingStrategy;
+use shadow_dcs::statistics::DcsCounter;
 use shadow_dcs::{CoveredSamples, Dcs};
 use shadow_io::SceneSetup;
 use shadow_scenes::builtin;
@@ -53,7 +54,10 @@ fn shared_preparations_and_frames_give_each_configuration_its_own_answer() {
         let pb = b.prepare_sharing(&pa).unwrap();
         let pc = c.prepare_sharing(&pa).unwrap();
         for p in [&pb, &pc] {
-            assert_eq!(p.preparation().counter("preparation-shared"), Some(1));
+            assert_eq!(
+                p.preparation().counter(DcsCounter::PreparationShared),
+                Some(1)
+            );
         }
         let shared = pc.estimate(&view, Outputs::PER_SAMPLE).unwrap();
         same(
@@ -63,7 +67,7 @@ fn shared_preparations_and_frames_give_each_configuration_its_own_answer() {
         );
         let reps = pa.estimate_replicates(&[&pb, &pc], &view).unwrap();
         assert_eq!(reps.len(), 3);
-        assert_eq!(reps[1].stats.counter("frame-shared"), Some(1));
+        assert_eq!(reps[1].stats.counter(DcsCounter::FrameShared), Some(1));
         for (r, d) in reps.iter().zip([&a, &b, &c]) {
             same(r, &alone(d, &setup, &view), &format!("{scene}: replicate"));
         }
@@ -90,11 +94,14 @@ fn a_configuration_whose_preparation_depends_on_its_samples_prepares_afresh() {
         .prepare_dcs(setup.scene.clone(), setup.lights[0].clone())
         .unwrap();
     let pt = tables.prepare_sharing(&pa).unwrap();
-    assert_eq!(pt.preparation().counter("preparation-shared"), Some(0));
+    assert_eq!(
+        pt.preparation().counter(DcsCounter::PreparationShared),
+        Some(0)
+    );
     let e = pt.estimate(&view, Outputs::PER_SAMPLE).unwrap();
     same(&e, &alone(&tables, &setup, &view), "tables");
     // A replicate that cannot share the frame is estimated on its own, with its own answer.
     let reps = pa.estimate_replicates(&[&pt], &view).unwrap();
-    assert_eq!(reps[1].stats.counter("frame-shared"), None);
+    assert_eq!(reps[1].stats.counter(DcsCounter::FrameShared), None);
     same(&reps[1], &e, "tables as a replicate");
 }

@@ -43,17 +43,14 @@ use shadow_core::sampling::{MAX_SAMPLES, SamplingError, hash_words, mix64, unit_
 use shadow_core::view_samples::ViewSample;
 
 use crate::bvh::BeamResult;
-use crate::reference::{Counts, PreparedReference, RAYS_COUNTER, Reference, Scratch, TRACE_PHASE};
+use crate::reference::{Counts, PreparedReference, Reference, Scratch};
+use crate::statistics::{RefCounter, RefGauge, RefPhase};
 
 /// Samples of each probe set by default (4 x 4 strata).
 pub const DEFAULT_BATCH: u32 = 16;
 /// The most samples a pixel draws by default: a 4096-sample progressive set (64 x 64) and
 /// the replicate.
 pub const DEFAULT_CAP: u32 = 4096 + DEFAULT_BATCH;
-/// The counter of samples the estimate drew (its mean per pixel is this over `pixels`).
-pub const SAMPLES_COUNTER: &str = "adaptive-samples";
-/// The gauge of the most samples one pixel drew.
-pub const MAX_SAMPLES_GAUGE: &str = "adaptive-max-samples-per-pixel";
 
 /// The adaptive reference: a configuration (target, probe size, cap, seed).
 #[derive(Debug, Clone)]
@@ -654,7 +651,7 @@ impl PreparedAdaptive {
         let (w, h) = (view.width() as usize, view.height() as usize);
         let schedule = &self.config.schedule;
         let mut stats = Stats::default();
-        let rows: Vec<(Vec<Acc>, Counts)> = stats.time(TRACE_PHASE, || {
+        let rows: Vec<(Vec<Acc>, Counts)> = stats.time(RefPhase::Trace, || {
             let probe: Vec<(Vec<Acc>, Counts)> = (0..h)
                 .into_par_iter()
                 .map(|row| {
@@ -755,27 +752,25 @@ impl PreparedAdaptive {
             }
         }
         let capped = stopped.last().copied().unwrap_or(0);
-        stats.add(RAYS_COUNTER, counts.rays);
-        stats.add("rays-single", counts.traversed);
-        stats.add("pixels-beam-clear", counts.beam_clear);
-        stats.add("pixels-beam-candidates", counts.beam_candidates);
-        stats.add("pixels-beam-fallback", counts.beam_fallback);
-        stats.add("pixels-lit-without-samples", counts.unsampled);
-        stats.add(SAMPLES_COUNTER, total);
-        stats.add("pixels", view.valid_count() as u64);
-        stats.add("pixels-at-cap", capped);
-        stats.add("pixels-without-samples", stopped[0]);
+        stats.add(RefCounter::OcclusionRays, counts.rays);
+        stats.add(RefCounter::RaysSingle, counts.traversed);
+        stats.add(RefCounter::PixelsBeamClear, counts.beam_clear);
+        stats.add(RefCounter::PixelsBeamCandidates, counts.beam_candidates);
+        stats.add(RefCounter::PixelsBeamFallback, counts.beam_fallback);
+        stats.add(RefCounter::PixelsLitWithoutSamples, counts.unsampled);
+        stats.add(RefCounter::AdaptiveSamples, total);
+        stats.add(RefCounter::Pixels, view.valid_count() as u64);
+        stats.add(RefCounter::PixelsAtCap, capped);
+        stats.add(RefCounter::PixelsWithoutSamples, stopped[0]);
         for (j, n) in stopped.iter().enumerate().skip(1) {
-            stats.add(
-                &format!("pixels-with-{}-progressive-samples", schedule[j - 1]),
+            stats.add_to_bucket(
+                RefCounter::PixelsByProgressiveSamples,
+                u64::from(schedule[j - 1]),
                 *n,
             );
         }
-        stats.gauge_max(MAX_SAMPLES_GAUGE, u64::from(most));
-        stats.gauge_max(
-            crate::reference::THREADS_GAUGE,
-            rayon::current_num_threads() as u64,
-        );
+        stats.gauge_max(RefGauge::AdaptiveMaxSamplesPerPixel, u64::from(most));
+        stats.gauge_max(RefGauge::Threads, rayon::current_num_threads() as u64);
         vis.set_classes(classes)?;
         vis.validate()?;
         let mut est = Estimate::new(vis, stats);

@@ -19,14 +19,14 @@
 //!
 //! ```
 //! use shadow_core::prelude::*;
-//! use shadow_ref::Reference;
+//! use shadow_ref::{Reference, RefCounter};
 //!
 //! let setup = shadow_scenes::builtin("quad-over-plane").unwrap();
 //! let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 24, 18).unwrap();
 //! let r = Reference::stratified(64, 1).unwrap();
 //! let prepared = r.prepare(setup.scene.clone(), setup.lights[0].clone()).unwrap();
 //! let est = prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
-//! assert!(est.stats.counter("occlusion-rays").unwrap() > 0);
+//! assert!(est.stats.counter(RefCounter::OcclusionRays).unwrap() > 0);
 //! ```
 
 #![deny(missing_docs)]
@@ -39,9 +39,11 @@ pub mod offset;
 pub mod rays;
 pub mod reference;
 pub mod sah;
+pub mod statistics;
 pub mod watertight;
 pub mod wide;
 
 pub use adaptive::AdaptiveReference;
 pub use rays::BvhRays;
 pub use reference::{PixelScratch, PreparedReference, Reference};
+pub use statistics::{RefCounter, RefGauge, RefPhase};

@@ -36,6 +36,7 @@ use shadow_core::sampling::SamplingError;
 use crate::beam::Beam;
 use crate::bvh::{BeamCandidates, BeamResult, OcclusionBvh};
 use crate::offset::RayOffset;
+use crate::statistics::{RefCounter, RefGauge, RefPhase};
 
 /// Where the reference takes its light samples from.
 #[derive(Debug, Clone, PartialEq)]
@@ -47,13 +48,6 @@ pub enum SampleSource {
     /// One sample at the light centre (hard shadow).
     Hard,
 }
-
-/// The phase of an estimate that traces the occlusion segments (for ray-rate figures).
-pub const TRACE_PHASE: &str = "trace";
-/// The counter of occlusion segments an estimate traced.
-pub const RAYS_COUNTER: &str = "occlusion-rays";
-/// The gauge of threads the trace ran on.
-pub const THREADS_GAUGE: &str = "threads";
 
 /// Receivers with fewer samples than this skip the beam (a single ray is cheaper).
 const BEAM_MIN_SAMPLES: usize = 4;
@@ -236,7 +230,7 @@ impl Reference {
         light: Light,
     ) -> Result<PreparedReference, TechniqueError> {
         let mut stats = Stats::default();
-        let bvh = stats.time("bvh-build", || OcclusionBvh::build(scene.as_ref()));
+        let bvh = stats.time(RefPhase::BvhBuild, || OcclusionBvh::build(scene.as_ref()));
         self.prepare_on(Arc::new(bvh), scene, light, stats)
     }
 
@@ -249,7 +243,7 @@ impl Reference {
         light: Light,
         mut stats: Stats,
     ) -> Result<PreparedReference, TechniqueError> {
-        stats.add("triangles", scene.triangle_count() as u64);
+        stats.add(RefCounter::Triangles, scene.triangle_count() as u64);
         let light: Light = if light.area() == 0.0 {
             Arc::new(
                 PointLight::new(light.center(), light.radiance().clone())
@@ -291,8 +285,8 @@ impl Reference {
             o.light.geometry().bounding_quad()
         };
         let mut stats = Stats::default();
-        stats.add("bvh-shared", 1);
-        stats.add("triangles", o.scene.triangle_count() as u64);
+        stats.add(RefCounter::BvhShared, 1);
+        stats.add(RefCounter::Triangles, o.scene.triangle_count() as u64);
         PreparedReference {
             config: self.clone(),
             p: Prepared {
@@ -539,7 +533,7 @@ impl ShadowTechnique for Reference {
                 let prepared = match &shared {
                     Some(bvh) => {
                         let mut stats = Stats::default();
-                        stats.add("bvh-shared", 1);
+                        stats.add(RefCounter::BvhShared, 1);
                         self.prepare_on(bvh.clone(), scene.clone(), light.clone(), stats)?
                     }
                     None => {
@@ -693,7 +687,7 @@ impl Reference {
             below: u64,
             counts: Counts,
         }
-        let rows: Vec<Row> = stats.time(TRACE_PHASE, || {
+        let rows: Vec<Row> = stats.time(RefPhase::Trace, || {
             (0..view.height() as usize)
                 .into_par_iter()
                 .map(|row| {
@@ -775,16 +769,16 @@ impl Reference {
             }
             classes.extend_from_slice(&r.class);
             bits.extend_from_slice(&r.bits);
-            stats.add(RAYS_COUNTER, r.rays);
-            stats.add("samples-below-horizon", r.below);
-            stats.add("rays-single", r.counts.traversed);
-            stats.add("pixels-beam-clear", r.counts.beam_clear);
-            stats.add("pixels-beam-candidates", r.counts.beam_candidates);
-            stats.add("pixels-beam-fallback", r.counts.beam_fallback);
-            stats.add("pixels-lit-without-samples", r.counts.unsampled);
+            stats.add(RefCounter::OcclusionRays, r.rays);
+            stats.add(RefCounter::SamplesBelowHorizon, r.below);
+            stats.add(RefCounter::RaysSingle, r.counts.traversed);
+            stats.add(RefCounter::PixelsBeamClear, r.counts.beam_clear);
+            stats.add(RefCounter::PixelsBeamCandidates, r.counts.beam_candidates);
+            stats.add(RefCounter::PixelsBeamFallback, r.counts.beam_fallback);
+            stats.add(RefCounter::PixelsLitWithoutSamples, r.counts.unsampled);
         }
-        stats.add("pixels", view.valid_count() as u64);
-        stats.gauge_max(THREADS_GAUGE, rayon::current_num_threads() as u64);
+        stats.add(RefCounter::Pixels, view.valid_count() as u64);
+        stats.gauge_max(RefGauge::Threads, rayon::current_num_threads() as u64);
         vis.set_classes(classes)?;
         if per_sample {
             vis.set_per_sample(PerSampleVisibility::Bits {

@@ -5,7 +5,8 @@
 use shadow_core::prelude::*;
 use shadow_io::SceneSetup;
 use shadow_metrics::compare;
-use shadow_ref::adaptive::{DEFAULT_BATCH, DEFAULT_CAP, SAMPLES_COUNTER};
+use shadow_ref::adaptive::{DEFAULT_BATCH, DEFAULT_CAP};
+use shadow_ref::statistics::RefCounter;
 use shadow_ref::{AdaptiveReference, Reference};
 use shadow_scenes::builtin;
 
@@ -34,7 +35,8 @@ fn achieved_rmse_follows_the_target() {
                 m.rmse
             );
             // Fewer samples than the uniform reference that reaches the same error.
-            let mean = e.stats.counter(SAMPLES_COUNTER).unwrap() as f64 / view.valid_count() as f64;
+            let mean = e.stats.counter(RefCounter::AdaptiveSamples).unwrap() as f64
+                / view.valid_count() as f64;
             let uniform = [16u32, 32, 64, 128, 256, 512, 1024, 2048, 4096]
                 .into_iter()
                 .find(|&n| {
@@ -63,7 +65,7 @@ fn adaptive_output_is_identical_whatever_the_thread_count() {
     let v1 = one.install(|| estimate(&a, &setup, &view));
     let v2 = estimate(&a, &setup, &view);
     assert_eq!(v1.visibility.coefficients(), v2.visibility.coefficients());
-    assert!(v1.stats.counter("pixels-without-samples").unwrap() > 0);
+    assert!(v1.stats.counter(RefCounter::PixelsWithoutSamples).unwrap() > 0);
 }
 
 #[test]

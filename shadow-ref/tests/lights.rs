@@ -3,11 +3,13 @@
 //! built once, a light behind every receiver is skipped with the V the reference gives it, and
 //! a refused light is named or traced by the fallback.
 
+use shadow_ref::statistics::RefCounter;
 use std::sync::Arc;
 
 use glam::Vec3;
 use shadow_core::lights::PreparedLights;
 use shadow_core::prelude::*;
+use shadow_core::stats::CoreCounter;
 use shadow_io::SceneSetup;
 use shadow_ref::Reference;
 
@@ -29,9 +31,9 @@ fn each_light_as_alone_and_direct_light_summed() {
     assert_eq!(setup.lights.len(), 3);
     let r = Reference::stratified(16, 5).unwrap();
     let all = PreparedLights::prepare(&r, None, setup.scene.clone(), &setup.lights).unwrap();
-    assert_eq!(all.preparation().counter("bvh-shared"), Some(2));
+    assert_eq!(all.preparation().counter(RefCounter::BvhShared), Some(2));
     let est = all.estimate(&view, DIRECT).unwrap();
-    assert_eq!(est.stats.counter("lights-shadowed"), Some(3));
+    assert_eq!(est.stats.counter(CoreCounter::LightsShadowed), Some(3));
     let mut sum = vec![Vec3::ZERO; view.len()];
     for (i, light) in setup.lights.iter().enumerate() {
         let alone = r
@@ -79,7 +81,7 @@ fn a_light_behind_every_receiver_is_skipped_with_the_v_the_reference_gives_it() 
     let r = Reference::stratified(16, 5).unwrap();
     let all = PreparedLights::prepare(&r, None, setup.scene.clone(), &lights).unwrap();
     let est = all.estimate(&view, DIRECT).unwrap();
-    assert_eq!(est.stats.counter("lights-skipped"), Some(1));
+    assert_eq!(est.stats.counter(CoreCounter::LightsSkipped), Some(1));
     assert!(est.lights[1].skipped && !est.lights[0].skipped);
     let alone = r
         .prepare(setup.scene.clone(), below)
@@ -145,7 +147,10 @@ fn a_refused_light_is_named_or_traced_by_the_fallback() {
     let fallback = Reference::stratified(16, 9).unwrap();
     let all =
         PreparedLights::prepare(&t, Some(&fallback), setup.scene.clone(), &setup.lights).unwrap();
-    assert_eq!(all.preparation().counter("lights-fallback"), Some(2));
+    assert_eq!(
+        all.preparation().counter(CoreCounter::LightsFallback),
+        Some(2)
+    );
     let est = all.estimate(&view, Outputs::VISIBILITY).unwrap();
     let names: Vec<&str> = est.lights.iter().map(|l| l.technique.as_str()).collect();
     assert_eq!(names, ["ref-16", "ref-16", "ref-16"]);

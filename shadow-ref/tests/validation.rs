@@ -7,6 +7,7 @@ use glam::{DVec2, UVec2, Vec3};
 use shadow_core::prelude::*;
 use shadow_io::SceneSetup;
 use shadow_ref::Reference;
+use shadow_ref::statistics::RefCounter;
 use shadow_ref::watertight::ShearedRay;
 use shadow_scenes::procedural::{floor, quad, uv_sphere};
 use shadow_scenes::{BUILTIN_SCENES, builtin, quad_over_plane as q};
@@ -604,8 +605,8 @@ fn beams_prove_lit_receivers_clear() {
         .prepare_reference(setup.scene.clone(), setup.lights[0].clone())
         .unwrap();
     let est = r_prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
-    let clear = est.stats.counter("pixels-beam-clear").unwrap();
-    let pixels = est.stats.counter("pixels").unwrap();
+    let clear = est.stats.counter(RefCounter::PixelsBeamClear).unwrap();
+    let pixels = est.stats.counter(RefCounter::Pixels).unwrap();
     assert!(2 * clear > pixels, "{clear} clear beams of {pixels} pixels");
 }
 

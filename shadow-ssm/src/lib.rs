@@ -18,14 +18,14 @@
 //!
 //! ```
 //! use shadow_core::prelude::*;
-//! use shadow_ssm::{Filter, ShadowMapFilter};
+//! use shadow_ssm::{Filter, ShadowMapFilter, SsmCounter};
 //!
 //! let setup = shadow_scenes::builtin("quad-over-plane").unwrap();
 //! let view = ViewSamples::render(setup.scene.as_ref(), &setup.camera_or_default(), 32, 24).unwrap();
 //! let pcss = ShadowMapFilter::new("pcss", Filter::Pcss, 256);
 //! let prepared = pcss.prepare(setup.scene.clone(), setup.lights[0].clone()).unwrap();
 //! let est = prepared.estimate(&view, Outputs::VISIBILITY).unwrap();
-//! assert!(est.stats.counter("pixels-umbra").unwrap() > 0);
+//! assert!(est.stats.counter(SsmCounter::PixelsUmbra).unwrap() > 0);
 //! ```
 
 #![deny(missing_docs)]
@@ -40,9 +40,11 @@ pub mod light_view;
 pub mod rect_union;
 pub mod screen_space;
 pub mod shadow_map;
+pub mod statistics;
 pub mod technique;
 
 pub use light_space::Contours;
+pub use statistics::{SsmCounter, SsmPhase};
 
 /// The cap on a midpoint's distance beyond its layer (BCS06 Fig. 5b) that the `ssm-peeling`
 /// preset uses, in world units: about a tenth of the built-in scenes' occluder heights.

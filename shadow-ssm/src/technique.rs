@@ -43,6 +43,7 @@ use crate::light_space::{self, Contours};
 use crate::light_view::MAX_OFF_AXIS_DEGREES;
 use crate::screen_space::{self, ScreenSpace};
 use crate::shadow_map::ShadowMap;
+use crate::statistics::{SsmCounter, SsmPhase};
 
 /// Largest number of taps per side of a filter or search square.
 pub const MAX_TAPS: u32 = 16;
@@ -387,7 +388,7 @@ impl ShadowTechnique for ShadowMapFilter {
             ));
         }
         let mut stats = Stats::default();
-        let frame = stats.time("light-frame", || {
+        let frame = stats.time(SsmPhase::LightFrame, || {
             LightFrame::new(light.as_ref(), &self.name)
         })?;
         let extent = scene.bounds().union(light.bounds()).diagonal();
@@ -441,7 +442,7 @@ impl ShadowMapFilter {
     fn run(&self, p: &Prepared, view: &ViewSamples) -> Result<Estimate, TechniqueError> {
         let mut stats = Stats::default();
         let n = view.len();
-        let horizon: Vec<f32> = stats.time("horizon", || {
+        let horizon: Vec<f32> = stats.time(SsmPhase::Horizon, || {
             (0..n)
                 .into_par_iter()
                 .map(|i| match view.get(i) {
@@ -460,7 +461,7 @@ impl ShadowMapFilter {
             .filter(|&i| horizon[i] > 0.0)
             .map(|i| origins[i])
             .collect();
-        let sm = stats.time("shadow-map", || {
+        let sm = stats.time(SsmPhase::ShadowMap, || {
             ShadowMap::render(
                 p.scene.as_ref(),
                 &p.frame,
@@ -483,7 +484,9 @@ impl ShadowMapFilter {
                 ));
             }
         }
-        let pyramid = stats.time("min-max-pyramid", || sm.as_ref().map(MinMaxPyramid::build));
+        let pyramid = stats.time(SsmPhase::MinMaxPyramid, || {
+            sm.as_ref().map(MinMaxPyramid::build)
+        });
         let textured = p.light.is_textured() && self.filter.integrates_the_light();
         let domain = sm.as_ref().map(|m| {
             let view_from_world = &m.view.view_from_world;
@@ -530,7 +533,7 @@ impl ShadowMapFilter {
             (perspective, view.width() as f32 / (r - l))
         });
         let selection = match (self.screen_space, self.filter) {
-            (Some(s), Filter::Contours(_)) => Some(stats.time("discontinuities", || {
+            (Some(s), Filter::Contours(_)) => Some(stats.time(SsmPhase::Discontinuities, || {
                 let spacing = s.pattern.clamp(2, 16).next_power_of_two() as usize;
                 let disc = screen_space::discontinuities(
                     view.width() as usize,
@@ -575,7 +578,7 @@ impl ShadowMapFilter {
                     }
                 });
         let eye = view.eye();
-        let rows: Vec<Row> = stats.time("filter", || {
+        let rows: Vec<Row> = stats.time(SsmPhase::Filter, || {
             (0..view.height() as usize)
                 .into_par_iter()
                 .map_init(Scratch::default, |scratch, row| {
@@ -690,7 +693,7 @@ impl ShadowMapFilter {
             reconstructed += r.reconstructed;
         }
         if reconstructed > 0 {
-            stats.time("pull-push", || {
+            stats.time(SsmPhase::PullPush, || {
                 let mut flat: Vec<f32> = values.iter().flat_map(|v| v.to_array()).collect();
                 // Background pixels carry no value: they must not feed the reconstruction.
                 let wts: Vec<f32> = (0..n)
@@ -720,22 +723,28 @@ impl ShadowMapFilter {
         }
         vis.set_classes(classes)?;
         let counts_by_class = vis.class_counts().unwrap_or_default();
-        stats.add("pixels-facing-away", facing_away);
-        stats.add("pixels-outside-frustum", outside);
-        stats.add("pixels-skipped-lit", lit);
-        stats.add("pixels-skipped-umbra", umbra);
-        stats.add("pixels-reconstructed", reconstructed);
-        stats.add("pixels-lit", counts_by_class[PixelClass::Lit as usize]);
-        stats.add("pixels-umbra", counts_by_class[PixelClass::Umbra as usize]);
+        stats.add(SsmCounter::PixelsFacingAway, facing_away);
+        stats.add(SsmCounter::PixelsOutsideFrustum, outside);
+        stats.add(SsmCounter::PixelsSkippedLit, lit);
+        stats.add(SsmCounter::PixelsSkippedUmbra, umbra);
+        stats.add(SsmCounter::PixelsReconstructed, reconstructed);
         stats.add(
-            "pixels-penumbra",
+            SsmCounter::PixelsLit,
+            counts_by_class[PixelClass::Lit as usize],
+        );
+        stats.add(
+            SsmCounter::PixelsUmbra,
+            counts_by_class[PixelClass::Umbra as usize],
+        );
+        stats.add(
+            SsmCounter::PixelsPenumbra,
             counts_by_class[PixelClass::Penumbra as usize],
         );
-        stats.add("shadow-map-texels", (self.resolution as u64).pow(2));
-        stats.add("contour-edges", counts.edges);
-        stats.add("contour-levels", counts.levels);
-        stats.add("pixels-blended", counts.blended);
-        stats.add("samples-read", counts.read);
+        stats.add(SsmCounter::ShadowMapTexels, (self.resolution as u64).pow(2));
+        stats.add(SsmCounter::ContourEdges, counts.edges);
+        stats.add(SsmCounter::ContourLevels, counts.levels);
+        stats.add(SsmCounter::PixelsBlended, counts.blended);
+        stats.add(SsmCounter::SamplesRead, counts.read);
         vis.validate()?;
         Ok(Estimate::new(vis, stats))
     }

@@ -6,6 +6,7 @@ use shadow_core::visibility::Coefficients;
 use shadow_io::SceneSetup;
 use shadow_metrics::compare;
 use shadow_ssm::backprojection::Backprojection;
+use shadow_ssm::statistics::SsmCounter;
 use shadow_ssm::{Contours, Filter, ScreenSpace, ShadowMapFilter};
 
 struct Case {
@@ -75,8 +76,8 @@ fn contours_beat_gap_filling_on_fine_occluders() {
             contours.bias.abs() < 0.5 * gap.bias.abs(),
             "{scene}: {contours:?}"
         );
-        assert!(est.stats.counter("contour-edges").unwrap() > 0);
-        assert!(est.stats.counter("pixels-skipped-lit").unwrap() > 0);
+        assert!(est.stats.counter(SsmCounter::ContourEdges).unwrap() > 0);
+        assert!(est.stats.counter(SsmCounter::PixelsSkippedLit).unwrap() > 0);
     }
 }
 
@@ -108,12 +109,12 @@ fn adaptive_contours_do_less_work_at_comparable_error() {
     );
     assert!(ea.rmse < 1.15 * ef.rmse, "adaptive {ea:?} full {ef:?}");
     let (wf, wa) = (
-        full.stats.counter("contour-edges").unwrap(),
-        fast.stats.counter("contour-edges").unwrap(),
+        full.stats.counter(SsmCounter::ContourEdges).unwrap(),
+        fast.stats.counter(SsmCounter::ContourEdges).unwrap(),
     );
     assert!(wa * 5 < wf, "edges: adaptive {wa}, full {wf}");
-    assert!(fast.stats.counter("pixels-reconstructed").unwrap() > 0);
-    assert!(fast.stats.counter("pixels-blended").unwrap() > 0);
+    assert!(fast.stats.counter(SsmCounter::PixelsReconstructed).unwrap() > 0);
+    assert!(fast.stats.counter(SsmCounter::PixelsBlended).unwrap() > 0);
 }
 
 /// Textured rectangle lights: the RGB visibility is the radiance integrated over the uncovered

@@ -15,7 +15,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use serde::Serialize;
-use shadow_auto::{Auto, AutoBudget, AutoModel, Config, Features, Observation, measure_features};
+use shadow_auto::{
+    Auto, AutoBudget, AutoModel, Config, Decision, Features, Observation, measure_features,
+};
 use shadow_core::prelude::*;
 use shadow_io::SceneSetup;
 use shadow_metrics::compare;
@@ -203,7 +205,7 @@ pub fn evaluate(
             let rmse = compare(&e.visibility, run.truth)
                 .map_err(|e| e.to_string())?
                 .rmse;
-            let d = &e.decision;
+            let d = Decision::of(&e).ok_or("auto gave no decision")?;
             let (met, fastest, feasible) = match budget {
                 AutoBudget::Rmse(r) => {
                     let fastest = mine
@@ -218,9 +220,9 @@ pub fn evaluate(
             out.push(AutoRun {
                 scene: run.name.into(),
                 budget,
-                choice: d["choice"].as_str().unwrap_or("?").into(),
-                predicted_rmse: d["predicted"]["rmse"].as_f64().unwrap_or(f64::NAN),
-                predicted_seconds: d["predicted"]["seconds"].as_f64().unwrap_or(f64::NAN),
+                choice: d.choice.clone(),
+                predicted_rmse: d.predicted.rmse,
+                predicted_seconds: d.predicted.seconds,
                 rmse,
                 seconds,
                 met,

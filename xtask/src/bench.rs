@@ -627,7 +627,7 @@ fn query_throughput(
                     .map_err(|e| e.to_string())?;
                 let secs = e
                     .stats
-                    .phase_seconds(shadow_ref::reference::TRACE_PHASE)
+                    .phase_seconds(shadow_ref::RefPhase::Trace)
                     .unwrap_or(f64::INFINITY);
                 trace_best = trace_best.min(secs);
             }

@@ -30,7 +30,8 @@ use shadow_core::prelude::*;
 use shadow_core::technique::{direct_from_per_sample, ratio_direct_from_per_sample};
 use shadow_io::SceneSetup;
 use shadow_metrics::compare;
-use shadow_ref::adaptive::{DEFAULT_BATCH, DEFAULT_CAP, SAMPLES_COUNTER};
+use shadow_ref::adaptive::{DEFAULT_BATCH, DEFAULT_CAP};
+use shadow_ref::statistics::{RefCounter, RefGauge};
 use shadow_ref::{AdaptiveReference, Reference};
 use shadow_scenes::{BUILTIN_SCENES, builtin};
 
@@ -211,14 +212,14 @@ pub fn run(a: BudgetsArgs) -> Result<(), String> {
                 .map_err(|e| e.to_string())?;
             let (secs, e) = timed(&r, &setup, &view, a.repeats)?;
             let mt = compare(&e.visibility, &truth.visibility).map_err(|e| e.to_string())?;
-            let samples = e.stats.counter(SAMPLES_COUNTER).unwrap_or(0);
-            let pixels = e.stats.counter("pixels").unwrap_or(1).max(1);
+            let samples = e.stats.counter(RefCounter::AdaptiveSamples).unwrap_or(0);
+            let pixels = e.stats.counter(RefCounter::Pixels).unwrap_or(1).max(1);
             adaptive.push(AdaptivePoint {
                 target,
                 rmse: mt.rmse,
                 seconds: secs,
                 mean_samples: samples as f64 / pixels as f64,
-                max_samples: e.stats.gauge(shadow_ref::adaptive::MAX_SAMPLES_GAUGE),
+                max_samples: e.stats.gauge(RefGauge::AdaptiveMaxSamplesPerPixel),
                 speedup: reference_time_at(&uniform, mt.rmse).map(|t| t / secs),
             });
         }

@@ -223,11 +223,11 @@ pub fn write_json(path: &Path, value: &impl Serialize) -> Result<(), String> {
 
 /// Occlusion rays per second per thread from a technique's estimate stats, when it counts rays.
 pub fn rays_per_second_per_thread(stats: &Stats) -> Option<f64> {
-    let rays = stats.counter(shadow_ref::reference::RAYS_COUNTER)?;
+    let rays = stats.counter(shadow_ref::RefCounter::OcclusionRays)?;
     let threads = stats
-        .gauge(shadow_ref::reference::THREADS_GAUGE)
+        .gauge(shadow_ref::RefGauge::Threads)
         .unwrap_or(1)
         .max(1);
-    let secs = stats.phase_seconds(shadow_ref::reference::TRACE_PHASE)?;
+    let secs = stats.phase_seconds(shadow_ref::RefPhase::Trace)?;
     (rays > 0 && secs > 0.0).then(|| rays as f64 / secs / threads as f64)
 }

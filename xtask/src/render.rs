@@ -7,6 +7,7 @@ use clap::Args;
 use glam::Vec3;
 use serde_json::json;
 use shadow_core::prelude::*;
+use shadow_core::stats::CorePhase;
 use shadow_io::SceneSetup;
 use shadow_io::image_io::{
     write_normal_exr, write_position_exr, write_radiance_png, write_rgb_exr, write_shaded_png,
@@ -305,7 +306,7 @@ impl Shading<'_> {
             stats["direct_illumination"] = json!({
                 "technique": t.name(),
                 "samples": t.light_sampler().map(|s| s.count()),
-                "seconds": est.stats.phase_seconds("direct"),
+                "seconds": est.stats.phase_seconds(CorePhase::Direct),
                 "ratio_estimator": ratio,
             });
         }
@@ -317,8 +318,8 @@ impl Shading<'_> {
         stats["lights"] = lights_json(indices, lights, &est);
         if let [one] = est.lights.as_slice() {
             stats["classes"] = json!(one.estimate.visibility.class_counts());
-            if !one.estimate.decision.is_null() {
-                let mut d = one.estimate.decision.clone();
+            if let Some(decision) = &one.estimate.decision {
+                let mut d = decision.to_json();
                 d["achieved_seconds"] = json!(est.stats.total_seconds());
                 stats["decision"] = d;
             }

@@ -5,6 +5,7 @@
 
 use super::pixel::PixelPass;
 use super::*;
+use crate::statistics::{DcsCounter, DcsGauge, DcsPhase};
 
 impl Dcs {
     /// Everything per frame before the per-pixel pass: the view samples' origins and horizons,
@@ -53,7 +54,7 @@ impl Dcs {
                 .collect(),
             _ => Vec::new(),
         };
-        stats.add("wedges", p.scan.len() as u64);
+        stats.add(DcsCounter::Wedges, p.scan.len() as u64);
         let mut f = Frame {
             origins,
             centred,
@@ -64,7 +65,7 @@ impl Dcs {
             bits: 0,
             view,
         };
-        let plan = stats.time("square-plan", || self.plan(p, &f, traceable));
+        let plan = stats.time(DcsPhase::SquarePlan, || self.plan(p, &f, traceable));
         self.integration_constants(p, &mut f, &plan, (eye, camera), stats);
         Ok((f, plan))
     }
@@ -83,13 +84,13 @@ impl Dcs {
         let c = p.shape.center;
         if plan.reference.is_some() {
             // The frame is traced: no shadow volume is needed.
-            stats.add("shadow-volumes-skipped", 1);
+            stats.add(DcsCounter::ShadowVolumesSkipped, 1);
             f.constants = vec![0; f.active.len()];
             f.bits = self.forced_bits.unwrap_or_else(|| width_for(0));
             return;
         }
         let (origins, centred) = (&f.origins, &f.centred);
-        let (constants, quads) = stats.time("shadow-volumes", || {
+        let (constants, quads) = stats.time(DcsPhase::ShadowVolumes, || {
             let eye_c = eye_constant(p.scene.as_ref(), p.units, eye, c);
             integration_constants(
                 &p.edges,
@@ -103,12 +104,12 @@ impl Dcs {
                 &f.active,
             )
         });
-        stats.add("shadow-volume-quads", quads);
+        stats.add(DcsCounter::ShadowVolumeQuads, quads);
         let max_constant = constants.par_iter().copied().max().unwrap_or(0).max(0) as u64;
         f.bits = self.forced_bits.unwrap_or_else(|| width_for(max_constant));
         f.constants = constants;
-        stats.gauge_max("max-integration-constant", max_constant);
-        stats.gauge_max("counter-bits", f.bits as u64);
+        stats.gauge_max(DcsGauge::MaxIntegrationConstant, max_constant);
+        stats.gauge_max(DcsGauge::CounterBits, f.bits as u64);
     }
 
     /// Runs the per-pixel pass over the square of `job`: its wedge pairs (from the wedges its
@@ -304,15 +305,17 @@ impl Dcs {
             .require(&self.name, scene.as_ref(), light.as_ref())?;
         let mut stats = Stats::default();
         let shape = LightShape::new(light.as_ref(), &self.name)?;
-        let (edges, units) = stats.time("edges", || scene_edges(scene.as_ref(), shape.center));
-        let sil = stats.time("silhouettes", || {
+        let (edges, units) = stats.time(DcsPhase::Edges, || {
+            scene_edges(scene.as_ref(), shape.center)
+        });
+        let sil = stats.time(DcsPhase::Silhouettes, || {
             silhouettes(&edges, &shape, self.detection)
         });
-        stats.add("edges", edges.len() as u64);
-        stats.add("silhouette-edges", sil.len() as u64);
+        stats.add(DcsCounter::Edges, edges.len() as u64);
+        stats.add(DcsCounter::SilhouetteEdges, sil.len() as u64);
         let tables = match self.covered {
             CoveredSamples::Discrete | CoveredSamples::Refined => {
-                Some(stats.time("discrete-tables", || {
+                Some(stats.time(DcsPhase::DiscreteTables, || {
                     DiscreteTables::build(
                         &self.sampler,
                         light.as_ref(),
@@ -337,7 +340,7 @@ impl Dcs {
             .iter()
             .map(|&i| CentredEdge::new(&edges[i as usize], cd))
             .collect();
-        let wedges = stats.time("wedges", || wedges(&edges, &sil, &shape));
+        let wedges = stats.time(DcsPhase::Wedges, || wedges(&edges, &sil, &shape));
         let planar = shape.plane.as_ref().map(|pl| PlanarLight {
             u: pl.u,
             v: pl.v,
@@ -404,15 +407,18 @@ impl Dcs {
             && o.rays.is_none();
         if !shareable {
             let mut fresh = self.prepare_dcs(other.p.scene.clone(), other.p.light.clone())?;
-            fresh.stats.add("preparation-shared", 0);
+            fresh.stats.add(DcsCounter::PreparationShared, 0);
             return Ok(fresh);
         }
         self.capabilities()
             .require(&self.name, other.p.scene.as_ref(), other.p.light.as_ref())?;
         let mut stats = Stats::default();
-        stats.add("preparation-shared", 1);
-        stats.add("edges", other.p.edges.len() as u64);
-        stats.add("silhouette-edges", other.p.silhouettes.len() as u64);
+        stats.add(DcsCounter::PreparationShared, 1);
+        stats.add(DcsCounter::Edges, other.p.edges.len() as u64);
+        stats.add(
+            DcsCounter::SilhouetteEdges,
+            other.p.silhouettes.len() as u64,
+        );
         Ok(PreparedDcs {
             config: self.clone(),
             p: Arc::clone(&other.p),
@@ -466,7 +472,7 @@ impl Dcs {
             depth: Vec<u32>,
             counts: Counts,
         }
-        let strips = stats.time("depth-complexity", || {
+        let strips = stats.time(DcsPhase::DepthComplexity, || {
             self.squares(plan, |job, buffers| {
                 let rect = job.rect;
                 let m = rect.len();
@@ -621,36 +627,36 @@ impl Dcs {
             })?,
             PerSampleOutput::None => {}
         }
-        stats.add("pixels-facing-away", counts.facing_away);
-        stats.add("pixels-constant-only", counts.constant_only);
-        stats.add("pixels-per-sample", counts.per_sample);
-        stats.add("edge-tests", counts.edge_tests);
-        stats.add("covered-updates", counts.covered_updates);
-        stats.add("counter-escalations", counts.escalations);
-        stats.add("plain-counter-fallbacks", counts.plain_fallback);
-        stats.add("negative-depth-complexity", counts.negative);
-        stats.add("edge-ties", counts.ties + counts.scan.ties);
-        stats.add("wedge-pixels-scanned", counts.scan.scanned);
-        stats.add("wedge-exact-weights", counts.scan.exact_weights);
-        stats.add("bin-block-wedges", plan.block_wedges);
-        stats.add("squares-traced", counts.traced_squares);
+        stats.add(DcsCounter::PixelsFacingAway, counts.facing_away);
+        stats.add(DcsCounter::PixelsConstantOnly, counts.constant_only);
+        stats.add(DcsCounter::PixelsPerSample, counts.per_sample);
+        stats.add(DcsCounter::EdgeTests, counts.edge_tests);
+        stats.add(DcsCounter::CoveredUpdates, counts.covered_updates);
+        stats.add(DcsCounter::CounterEscalations, counts.escalations);
+        stats.add(DcsCounter::PlainCounterFallbacks, counts.plain_fallback);
+        stats.add(DcsCounter::NegativeDepthComplexity, counts.negative);
+        stats.add(DcsCounter::EdgeTies, counts.ties + counts.scan.ties);
+        stats.add(DcsCounter::WedgePixelsScanned, counts.scan.scanned);
+        stats.add(DcsCounter::WedgeExactWeights, counts.scan.exact_weights);
+        stats.add(DcsCounter::BinBlockWedges, plan.block_wedges);
+        stats.add(DcsCounter::SquaresTraced, counts.traced_squares);
         if let Some([dcs, volumes, rays, bvh]) = plan.predicted {
             // Whole rays: the predictions are far below u64's range.
-            stats.add("predicted-dcs-rays", dcs as u64);
-            stats.add("predicted-shadow-volume-rays", volumes as u64);
-            stats.add("predicted-traced-rays", rays as u64);
-            stats.add("predicted-bvh-rays", bvh as u64);
+            stats.add(DcsCounter::PredictedDcsRays, dcs as u64);
+            stats.add(DcsCounter::PredictedShadowVolumeRays, volumes as u64);
+            stats.add(DcsCounter::PredictedTracedRays, rays as u64);
+            stats.add(DcsCounter::PredictedBvhRays, bvh as u64);
         }
-        stats.add("pixels-traced", counts.traced_pixels);
-        stats.add("occlusion-rays", counts.rays);
-        stats.add("bin-square-wedges", counts.scan.square_wedges);
-        stats.add("bin-tile-wedges", counts.scan.tile_wedges);
-        stats.add("wedge-pairs", counts.pairs);
-        stats.add("wedge-pairs-off-light", counts.off_light);
-        stats.add("wedge-pairs-empty-sector", counts.sector_empty);
-        stats.add("refined-line-cells", counts.line_cells);
-        stats.add("pixels-shared-sample-sets", counts.shared_set_pixels);
-        stats.add("shared-sample-sets-built", counts.shared_sets_built);
+        stats.add(DcsCounter::PixelsTraced, counts.traced_pixels);
+        stats.add(DcsCounter::OcclusionRays, counts.rays);
+        stats.add(DcsCounter::BinSquareWedges, counts.scan.square_wedges);
+        stats.add(DcsCounter::BinTileWedges, counts.scan.tile_wedges);
+        stats.add(DcsCounter::WedgePairs, counts.pairs);
+        stats.add(DcsCounter::WedgePairsOffLight, counts.off_light);
+        stats.add(DcsCounter::WedgePairsEmptySector, counts.sector_empty);
+        stats.add(DcsCounter::RefinedLineCells, counts.line_cells);
+        stats.add(DcsCounter::PixelsSharedSampleSets, counts.shared_set_pixels);
+        stats.add(DcsCounter::SharedSampleSetsBuilt, counts.shared_sets_built);
         vis.validate()?;
         Ok(Estimate::new(vis, stats))
     }
@@ -681,7 +687,7 @@ impl PreparedDcs {
         for o in others {
             let mut est = if Arc::ptr_eq(&self.p, &o.p) && self.config.same_frame(&o.config) {
                 let mut stats = Stats::default();
-                stats.add("frame-shared", 1);
+                stats.add(DcsCounter::FrameShared, 1);
                 o.config.finish(&o.p, &f, &plan, view, output, stats)?
             } else {
                 o.config.run(&o.p, view, output)?

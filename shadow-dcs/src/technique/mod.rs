@@ -676,6 +676,7 @@ impl PreparedDcs {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::statistics::DcsCounter;
 
     /// Every square's values land on their own pixels, for an image whose sides are not whole
     /// squares or blocks, one value and three values per pixel, and an empty output is left
@@ -753,17 +754,25 @@ mod tests {
                 let case = format!("{name} {strategy:?} {covered:?}");
                 assert_eq!(depth(&shared), depth(&own), "{case}");
                 let (pixels, built) = (
-                    shared.stats.counter("pixels-shared-sample-sets").unwrap(),
-                    shared.stats.counter("shared-sample-sets-built").unwrap(),
+                    shared
+                        .stats
+                        .counter(DcsCounter::PixelsSharedSampleSets)
+                        .unwrap(),
+                    shared
+                        .stats
+                        .counter(DcsCounter::SharedSampleSetsBuilt)
+                        .unwrap(),
                 );
                 assert_eq!(
-                    own.stats.counter("pixels-shared-sample-sets").unwrap(),
+                    own.stats
+                        .counter(DcsCounter::PixelsSharedSampleSets)
+                        .unwrap(),
                     0,
                     "{case}"
                 );
                 assert_eq!(
                     pixels,
-                    shared.stats.counter("pixels-per-sample").unwrap(),
+                    shared.stats.counter(DcsCounter::PixelsPerSample).unwrap(),
                     "{case}"
                 );
                 let sets = match strategy {
