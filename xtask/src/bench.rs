@@ -17,12 +17,13 @@ use shadow_core::prelude::*;
 use shadow_io::SceneSetup;
 use shadow_io::image_io::shaded_image;
 use shadow_metrics::compare;
+use shadow_presets::Preset;
 use shadow_ref::Reference;
 use shadow_scenes::procedural::{floor, uv_sphere};
 use shadow_scenes::{BUILTIN_SCENES, builtin};
 
 use crate::bench_summary::{Measured, median, tables, write_docs};
-use crate::common::{machine, progress, rays_per_second_per_thread, write_json};
+use crate::common::{Machine, machine, progress, rays_per_second_per_thread, write_json};
 use crate::ensure_dir;
 use crate::flip::flip;
 use crate::plot::{Series, log_log, pareto_front};
@@ -213,6 +214,50 @@ pub fn run(mut a: BenchArgs) -> Result<(), String> {
     ensure_dir(&a.out)?;
     let m = machine();
     let seed = 1u64;
+    let truth_samples = if a.quick { 1024 } else { 4096 };
+    let points = time_against_error(&a, &presets, seed, truth_samples)?;
+    write_summary(&a, &points, truth_samples)?;
+    write_points(&a, &m, &points, truth_samples)?;
+    if a.study_only {
+        return Ok(());
+    }
+    let scaling = scaling_sweeps(&a, &presets, seed)?;
+    let throughput = reference_throughput(&a, &m, seed)?;
+    let query = query_throughput(&throughput.bunny, &a, seed)?;
+    println!(
+        "bunny, {} identical segments, one thread: single-ray query {:.2} M rays/s (wide tree; {:.2} M rays/s on the CWBVH); reference trace with beam culling {:.2} M rays/s ({:.1}% occluded)",
+        query.rays,
+        query.rays_per_second / 1e6,
+        query.cwbvh_rays_per_second / 1e6,
+        query.reference_rays_per_second / 1e6,
+        100.0 * query.occluded_share
+    );
+    // Files (bench.csv is written with the study).
+    write_scaling_csv(&a, &m, &scaling)?;
+    write_json(
+        &a.out.join("bench.json"),
+        &json!({
+            "machine": m, "width": a.width, "height": a.height, "repeats": a.repeats, "ground_truth_samples": truth_samples,
+            "time_error": points, "scaling": scaling,
+            "throughput": {"scene": "bunny", "size": throughput.size, "samples": 64, "rays_per_second_one_thread": throughput.one, "rays_per_second_per_thread_all": throughput.all, "threads": m.threads},
+        "query_throughput": query,
+        }),
+    )?;
+    plot_pareto_fronts(&a, &points)?;
+    plot_scaling(&a, &scaling)?;
+    plot_samples(&a, &points)?;
+    println!("wrote {}", a.out.display());
+    Ok(())
+}
+
+/// Time against error: the reference at each count of its sweep and every preset (over its
+/// sample sweep when it has one) on every scene, against a `truth_samples` reference.
+fn time_against_error(
+    a: &BenchArgs,
+    presets: &[Preset],
+    seed: u64,
+    truth_samples: u32,
+) -> Result<Vec<Point>, String> {
     let ref_counts: Vec<u32> = if a.quick {
         vec![1, 4, 16, 64, 256]
     } else {
@@ -223,7 +268,6 @@ pub fn run(mut a: BenchArgs) -> Result<(), String> {
     } else {
         vec![4, 16, 64, 256, 1024]
     };
-    let truth_samples = if a.quick { 1024 } else { 4096 };
     let mut points: Vec<Point> = Vec::new();
     let pb = progress(
         (a.scenes.len() * (ref_counts.len() + presets.len() * sweep.len())) as u64,
@@ -280,7 +324,7 @@ pub fn run(mut a: BenchArgs) -> Result<(), String> {
             pb.inc(1);
         }
         let mut swept: Vec<(serde_json::Value, String)> = Vec::new();
-        for p in &presets {
+        for p in presets {
             pb.set_message(format!("{scene}: {}", p.name));
             let caps = (p.make)(seed).capabilities();
             if caps
@@ -321,14 +365,16 @@ pub fn run(mut a: BenchArgs) -> Result<(), String> {
         }
     }
     pb.finish_and_clear();
-    write_summary(&a, &points, truth_samples)?;
-    write_points(&a, &m, &points, truth_samples)?;
-    if a.study_only {
-        return Ok(());
-    }
+    Ok(points)
+}
 
-    // Scaling sweeps: every preset at its own parameters.
-    let mut scaling: Vec<ScalingPoint> = Vec::new();
+/// Scaling sweeps, every preset at its own parameters: triangles (a sphere of more rings),
+/// light size, and image size (`bunny`).
+fn scaling_sweeps(
+    a: &BenchArgs,
+    presets: &[Preset],
+    seed: u64,
+) -> Result<Vec<ScalingPoint>, String> {
     let rings: Vec<u32> = if a.quick {
         vec![8, 32, 64]
     } else {
@@ -340,72 +386,60 @@ pub fn run(mut a: BenchArgs) -> Result<(), String> {
     } else {
         vec![64, 128, 256, 512]
     };
-    let pb = progress(
-        (presets.len() * (rings.len() + sides.len() + widths.len())) as u64,
-        "scaling",
-    );
-    for p in &presets {
+    let mut scenes: Vec<(&str, f64, SceneSetup, u32, u32)> = Vec::new();
+    for &r in &rings {
+        let s = sphere_scene(r);
+        let x = s.scene.triangle_count() as f64;
+        scenes.push(("triangles", x, s, a.width, a.height));
+    }
+    for &side in &sides {
+        scenes.push((
+            "light-size",
+            side as f64,
+            light_size_scene(side)?,
+            a.width,
+            a.height,
+        ));
+    }
+    for &w in &widths {
+        let s = builtin("bunny").map_err(|e| e.to_string())?;
+        scenes.push(("image-size", f64::NAN, s, w, w * 3 / 4));
+    }
+    let pb = progress((presets.len() * scenes.len()) as u64, "scaling");
+    let mut scaling: Vec<ScalingPoint> = Vec::new();
+    for p in presets {
         let make = || (p.make)(seed);
-        for &r in &rings {
-            let s = sphere_scene(r);
-            let v =
-                ViewSamples::render(s.scene.as_ref(), &s.camera_or_default(), a.width, a.height)
-                    .map_err(|e| e.to_string())?;
-            let Some((secs, ..)) = timed(&make, &s, &v, a.repeats)? else {
-                pb.inc(1);
-                continue;
-            };
-            scaling.push(ScalingPoint {
-                sweep: "triangles".into(),
-                technique: p.name.into(),
-                x: s.scene.triangle_count() as f64,
-                seconds: secs,
-                triangles: s.scene.triangle_count(),
-                pixels: v.valid_count(),
-            });
-            pb.inc(1);
-        }
-        for &side in &sides {
-            let s = light_size_scene(side)?;
-            let v =
-                ViewSamples::render(s.scene.as_ref(), &s.camera_or_default(), a.width, a.height)
-                    .map_err(|e| e.to_string())?;
-            let Some((secs, ..)) = timed(&make, &s, &v, a.repeats)? else {
-                pb.inc(1);
-                continue;
-            };
-            scaling.push(ScalingPoint {
-                sweep: "light-size".into(),
-                technique: p.name.into(),
-                x: side as f64,
-                seconds: secs,
-                triangles: s.scene.triangle_count(),
-                pixels: v.valid_count(),
-            });
-            pb.inc(1);
-        }
-        for &w in &widths {
-            let s = builtin("bunny").map_err(|e| e.to_string())?;
-            let v = ViewSamples::render(s.scene.as_ref(), &s.camera_or_default(), w, w * 3 / 4)
+        for (sweep, x, s, w, h) in &scenes {
+            let v = ViewSamples::render(s.scene.as_ref(), &s.camera_or_default(), *w, *h)
                 .map_err(|e| e.to_string())?;
-            let Some((secs, ..)) = timed(&make, &s, &v, a.repeats)? else {
-                pb.inc(1);
+            pb.inc(1);
+            let Some((secs, ..)) = timed(&make, s, &v, a.repeats)? else {
                 continue;
             };
             scaling.push(ScalingPoint {
-                sweep: "image-size".into(),
+                sweep: (*sweep).into(),
                 technique: p.name.into(),
-                x: v.len() as f64,
+                // The image-size sweep's abscissa is the image's pixel count.
+                x: if x.is_nan() { v.len() as f64 } else { *x },
                 seconds: secs,
                 triangles: s.scene.triangle_count(),
                 pixels: v.valid_count(),
             });
-            pb.inc(1);
         }
     }
     pb.finish_and_clear();
+    Ok(scaling)
+}
 
-    // Throughput of the reference's occlusion query on bunny.
+/// The reference's occlusion-ray rate on `bunny`, on one thread and per thread on all.
+struct RayThroughput {
+    bunny: SceneSetup,
+    size: u32,
+    one: f64,
+    all: f64,
+}
+
+fn reference_throughput(a: &BenchArgs, m: &Machine, seed: u64) -> Result<RayThroughput, String> {
     let bunny = builtin("bunny").map_err(|e| e.to_string())?;
     let size = if a.quick { 256 } else { 512 };
     let view = ViewSamples::render(bunny.scene.as_ref(), &bunny.camera_or_default(), size, size)
@@ -434,22 +468,20 @@ pub fn run(mut a: BenchArgs) -> Result<(), String> {
         all / 1e6,
         m.threads
     );
-    let query = query_throughput(&bunny, &a, seed)?;
-    println!(
-        "bunny, {} identical segments, one thread: single-ray query {:.2} M rays/s (wide tree; {:.2} M rays/s on the CWBVH); reference trace with beam culling {:.2} M rays/s ({:.1}% occluded)",
-        query.rays,
-        query.rays_per_second / 1e6,
-        query.cwbvh_rays_per_second / 1e6,
-        query.reference_rays_per_second / 1e6,
-        100.0 * query.occluded_share
-    );
+    Ok(RayThroughput {
+        bunny,
+        size,
+        one,
+        all,
+    })
+}
 
-    // Files (bench.csv is written with the study).
+fn write_scaling_csv(a: &BenchArgs, m: &Machine, scaling: &[ScalingPoint]) -> Result<(), String> {
     let mut csv = format!(
         "# {} | {} threads | {}\nsweep,technique,x,seconds_median,triangles,valid_pixels\n",
         m.cpu, m.threads, m.date
     );
-    for s in &scaling {
+    for s in scaling {
         writeln!(
             csv,
             "{},{},{},{:.5},{},{}",
@@ -457,16 +489,11 @@ pub fn run(mut a: BenchArgs) -> Result<(), String> {
         )
         .ok();
     }
-    std::fs::write(a.out.join("scaling.csv"), csv).map_err(|e| e.to_string())?;
-    write_json(
-        &a.out.join("bench.json"),
-        &json!({
-            "machine": m, "width": a.width, "height": a.height, "repeats": a.repeats, "ground_truth_samples": truth_samples,
-            "time_error": points, "scaling": scaling,
-            "throughput": {"scene": "bunny", "size": size, "samples": 64, "rays_per_second_one_thread": one, "rays_per_second_per_thread_all": all, "threads": m.threads},
-        "query_throughput": query,
-        }),
-    )?;
+    std::fs::write(a.out.join("scaling.csv"), csv).map_err(|e| e.to_string())
+}
+
+/// Per scene, each technique's error against time and the Pareto front over them all.
+fn plot_pareto_fronts(a: &BenchArgs, points: &[Point]) -> Result<(), String> {
     for scene in &a.scenes {
         let mut series: Vec<Series> = Vec::new();
         let mut names: Vec<&str> = points
@@ -500,6 +527,11 @@ pub fn run(mut a: BenchArgs) -> Result<(), String> {
             &series,
         )?;
     }
+    Ok(())
+}
+
+/// Seconds against each scaling sweep's abscissa, per technique.
+fn plot_scaling(a: &BenchArgs, scaling: &[ScalingPoint]) -> Result<(), String> {
     for (sweep, label) in [
         ("triangles", "triangles"),
         ("light-size", "light side (m)"),
@@ -531,7 +563,11 @@ pub fn run(mut a: BenchArgs) -> Result<(), String> {
             &series,
         )?;
     }
-    // Samples sweep from the time-error points.
+    Ok(())
+}
+
+/// Seconds against samples per pixel on the first scene, from the time-error points.
+fn plot_samples(a: &BenchArgs, points: &[Point]) -> Result<(), String> {
     let mut names: Vec<&str> = points
         .iter()
         .filter(|p| p.samples.is_some())
@@ -558,9 +594,7 @@ pub fn run(mut a: BenchArgs) -> Result<(), String> {
         "samples per pixel",
         "seconds (median)",
         &series,
-    )?;
-    println!("wrote {}", a.out.display());
-    Ok(())
+    )
 }
 
 #[derive(Debug, Clone, Serialize)]

@@ -10,17 +10,18 @@ use std::path::PathBuf;
 use clap::Args;
 use serde_json::json;
 use shadow_conformance::conformance::{
-    BUDGET_RESOLUTION, Outcome, ReceiverMode, SceneContext, SuiteConfig, reference_curve,
-    reference_time_at, run_case,
+    BUDGET_RESOLUTION, CaseReport, CurvePoint, Outcome, ReceiverMode, SceneContext, SuiteConfig,
+    reference_curve, reference_time_at, run_case,
 };
 use shadow_conformance::lights::EveryLight;
+use shadow_core::visibility::VisibilityImage;
 use shadow_io::image_io::{shaded_image, write_error_png, write_visibility_png};
 use shadow_metrics::compare;
 use shadow_scenes::{BUILTIN_SCENES, builtin};
 
-use crate::common::{machine, progress, write_json};
+use crate::common::{Machine, machine, progress, write_json};
 use crate::ensure_dir;
-use crate::flip::flip;
+use crate::flip::{Flip, flip};
 use crate::html::{self, Picture};
 
 fn picture(caption: &str, path: PathBuf) -> Picture {
@@ -96,7 +97,7 @@ const CURVE: [u32; 6] = [1, 4, 16, 64, 256, 1024];
 
 /// The report's table of multi-light scenes: each light's RMSE (with who shadowed it where the
 /// preset refused it) and the summed direct light's relative RMSE, per preset.
-fn every_light_section(md: &mut String, cases: &[(&str, String, EveryLight)]) {
+fn every_light_section(md: &mut String, cases: &[(String, String, EveryLight)]) {
     if cases.is_empty() {
         return;
     }
@@ -161,53 +162,48 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
     };
     ensure_dir(&a.out)?;
     let pb = progress((scenes.len() * (chosen.len() + 1)) as u64, "conformance");
-    let mut rows = Vec::new();
-    let mut failures = Vec::new();
-    let mut md = String::new();
     let m = machine();
-    writeln!(md, "# Conformance report\n\n{} x {} pixels, reference {} samples per pixel, seed {}. Machine: {} ({} threads), {}.\n", a.width, a.height, a.ref_samples, a.seed, m.cpu, m.threads, m.date).ok();
-    writeln!(md, "Speed-up: the reference's time at the technique's RMSE against the independent reference (the stratified reference at {} samples with its own seed, never the same-samples one a sample-based technique's budget is checked against), by log-log interpolation of the reference at {CURVE:?} samples measured against the same independent reference, divided by the technique's time; `>` when the technique beats every reference run.\n", a.ref_samples).ok();
-    writeln!(md, "FLIP: the mean FLIP (NVIDIA's perceptual difference, Andersson et al. 2020, at 67 pixels per degree) of the technique's shaded image against the reference's, over the pixels holding a view sample.\n").ok();
-    writeln!(md, "| technique | scene | RMSE | penumbra RMSE | FLIP | bias | max | share > 0.1 | phases (s) | speed-up | status |\n|---|---|---|---|---|---|---|---|---|---|---|").ok();
-    // The first column fits the longest preset name.
-    let name_width = chosen
-        .iter()
-        .map(|p| p.name.len())
-        .max()
-        .unwrap_or(9)
-        .max(9);
-    // The second fits the longest scene name (corpus names run to 34 characters).
-    let scene_width = scenes.iter().map(String::len).max().unwrap_or(5).max(22);
-    println!(
-        "{:<name_width$} {:<scene_width$} {:>8} {:>8} {:>7} {:>8} {:>6} {:>7} {:>28} {:>9}  status",
-        "technique",
-        "scene",
-        "RMSE",
-        "pen.RMSE",
-        "FLIP",
-        "bias",
-        "max",
-        ">0.1",
-        "phases (s)",
-        "speed-up"
-    );
-    let mut html_scenes = Vec::new();
-    let mut every_light = Vec::new();
+    let name_width = chosen.iter().map(|p| p.name.len()).max().unwrap_or(9);
+    let mut report = Report::new(&a, &m, name_width, &scenes);
     for scene in &scenes {
         pb.set_message(format!("{scene}: reference"));
         let ctx = SceneContext::new(builtin(scene).map_err(|e| e.to_string())?, cfg)?;
-        let curve = reference_curve(&ctx, &CURVE)?;
-        let dir = a.out.join(scene);
+        let mut run = SceneRun::new(&ctx, a.out.join(scene), scene)?;
+        pb.inc(1);
+        for p in &chosen {
+            pb.set_message(format!("{scene}: {}", p.name));
+            let outcome = run_case(p, &ctx);
+            pb.inc(1);
+            report.case(p.name, &mut run, outcome)?;
+        }
+        report.html_scenes.push(run.html);
+    }
+    pb.finish_and_clear();
+    report.write(&a, &m, cfg)
+}
+
+/// One scene's reference and what each case on it is compared and shown with.
+struct SceneRun<'a> {
+    ctx: &'a SceneContext,
+    dir: PathBuf,
+    scene: &'a str,
+    curve: Vec<CurvePoint>,
+    reference: &'a VisibilityImage,
+    ref_secs: f64,
+    reference_shaded: image::RgbImage,
+    html: html::Scene,
+}
+
+impl<'a> SceneRun<'a> {
+    /// The reference and its curve, their images written under `dir`.
+    fn new(ctx: &'a SceneContext, dir: PathBuf, scene: &'a str) -> Result<Self, String> {
+        let curve = reference_curve(ctx, &CURVE)?;
         ensure_dir(&dir)?;
         let (reference, ref_secs) = ctx.reference()?;
         write_visibility_png(&dir.join("reference.png"), reference).map_err(|e| e.to_string())?;
-        let shade = |v: &dyn shadow_core::visibility::VisibilityBuffer| {
-            shaded_image(ctx.setup.scene.as_ref(), &ctx.view, ctx.light().as_ref(), v)
-                .map_err(|e| e.to_string())
-        };
-        let reference_shaded = shade(reference)?;
+        let reference_shaded = shade(ctx, reference)?;
         save(&reference_shaded, &dir.join("reference-shaded.png"))?;
-        let mut html_scene = html::Scene {
+        let html = html::Scene {
             name: scene.to_string(),
             reference: vec![
                 picture("visibility", dir.join("reference.png")),
@@ -216,190 +212,296 @@ pub fn run(a: ConformanceArgs) -> Result<(), String> {
             curve: curve.iter().map(|c| (c.seconds, c.rmse)).collect(),
             cases: Vec::new(),
         };
-        let html_case = |technique: &str, status: String| html::Case {
-            technique: technique.to_string(),
-            status,
-            rmse: None,
-            penumbra_rmse: None,
-            flip: None,
-            seconds: None,
-            independent_rmse: None,
-            speedup: String::new(),
-            pictures: Vec::new(),
-        };
-        pb.inc(1);
-        for p in &chosen {
-            pb.set_message(format!("{scene}: {}", p.name));
-            let outcome = run_case(p, &ctx);
-            pb.inc(1);
-            match outcome {
-                Outcome::Unsupported { reason } => {
-                    println!(
-                        "{:<name_width$} {:<scene_width$} unsupported: {reason}",
-                        p.name, scene
-                    );
-                    writeln!(
-                        md,
-                        "| {} | {} | | | | | | | | unsupported: {} |",
-                        p.name, scene, reason
-                    )
-                    .ok();
-                    rows.push(json!({"technique": p.name, "scene": scene, "status": "unsupported", "reason": reason}));
-                    html_scene
-                        .cases
-                        .push(html_case(p.name, format!("unsupported: {reason}")));
-                }
-                Outcome::Failed { error } => {
-                    println!(
-                        "{:<name_width$} {:<scene_width$} FAILED: {error}",
-                        p.name, scene
-                    );
-                    writeln!(
-                        md,
-                        "| {} | {} | | | | | | | | FAILED: {} |",
-                        p.name, scene, error
-                    )
-                    .ok();
-                    failures.push(format!("{} on {scene}: {error}", p.name));
-                    rows.push(json!({"technique": p.name, "scene": scene, "status": "failed", "error": error}));
-                    html_scene
-                        .cases
-                        .push(html_case(p.name, format!("FAILED: {error}")));
-                }
-                Outcome::Ran(r) => {
-                    let case_dir = dir.join(p.name);
-                    ensure_dir(&case_dir)?;
-                    write_visibility_png(&case_dir.join("visibility.png"), &r.estimate)
-                        .map_err(|e| e.to_string())?;
-                    write_error_png(&case_dir.join("error.png"), &r.estimate, &r.reference, 0.5)
-                        .map_err(|e| e.to_string())?;
-                    let shaded = shade(&r.estimate)?;
-                    save(&shaded, &case_dir.join("shaded.png"))?;
-                    let perceptual = flip(&reference_shaded, &shaded, &ctx.view)?;
-                    save(&perceptual.map, &case_dir.join("flip.png"))?;
-                    let phases = r
-                        .prepare_stats
-                        .phases
-                        .iter()
-                        .chain(&r.estimate_stats.phases)
-                        .map(|ph| format!("{} {:.3}", ph.name, ph.seconds))
-                        .collect::<Vec<_>>()
-                        .join(", ");
-                    // Against the independent reference: for a sample-based technique the
-                    // same-samples error is its own approximation only (0 for exact DCS).
-                    let independent_rmse = if r.same_samples {
-                        compare(&r.estimate, reference)
-                            .map_err(|e| e.to_string())?
-                            .rmse
-                    } else {
-                        r.metrics.rmse
-                    };
-                    let speedup = match reference_time_at(&curve, independent_rmse) {
-                        Some(t) => format!("{:.2}x", t / r.seconds),
-                        None => format!(
-                            ">{:.2}x",
-                            curve.last().map_or(0.0, |c| c.seconds) / r.seconds
-                        ),
-                    };
-                    let status = if r.passed() {
-                        "ok".to_string()
-                    } else {
-                        format!("FAIL: {}", r.violations.join("; "))
-                    };
-                    let status = if r.notes.is_empty() {
-                        status
-                    } else {
-                        format!("{status} (note: {})", r.notes.join("; "))
-                    };
-                    for v in &r.violations {
-                        failures.push(format!("{} on {scene}: {v}", p.name));
-                    }
-                    let pen = r
-                        .metrics
-                        .penumbra_rmse
-                        .map_or("-".to_string(), |v| format!("{v:.4}"));
-                    let cells = [
-                        p.name.to_string(),
-                        scene.to_string(),
-                        format!("{:.4}", r.metrics.rmse),
-                        pen,
-                        format!("{:.4}", perceptual.mean),
-                        format!("{:+.4}", r.metrics.bias),
-                        format!("{:.3}", r.metrics.max_abs),
-                        format!("{:.4}", r.metrics.share_over_0_1),
-                        phases,
-                        speedup,
-                        status,
-                    ];
-                    let widths = [name_width, scene_width, 8, 8, 7, 8, 6, 7, 28, 9, 0];
-                    let line: Vec<String> = cells
-                        .iter()
-                        .zip(widths)
-                        .enumerate()
-                        .map(|(k, (c, w))| {
-                            if k < 2 {
-                                format!("{c:<w$}")
-                            } else {
-                                format!("{c:>w$}")
-                            }
-                        })
-                        .collect();
-                    println!("{}", line.join(" "));
-                    writeln!(md, "| {} |", cells.join(" | ")).ok();
-                    if let Some(e) = &r.every_light {
-                        every_light.push((p.name, scene.clone(), e.clone()));
-                    }
-                    let mut row = serde_json::to_value(&*r).map_err(|e| e.to_string())?;
-                    row["status"] = json!(if r.passed() { "ok" } else { "fail" });
-                    row["rmse_against_independent_reference"] = json!(independent_rmse);
-                    row["flip"] = json!(perceptual.mean);
-                    row["speedup_at_equal_error"] =
-                        json!(reference_time_at(&curve, independent_rmse).map(|t| t / r.seconds));
-                    row["reference_curve"] = json!(curve);
-                    row["reference_seconds_high"] = json!(ref_secs);
-                    rows.push(row);
-                    let mut case = html_case(p.name, cells[cells.len() - 1].clone());
-                    case.rmse = Some(r.metrics.rmse);
-                    case.penumbra_rmse = r.metrics.penumbra_rmse;
-                    case.flip = Some(perceptual.mean);
-                    case.seconds = Some(r.seconds);
-                    case.independent_rmse = Some(independent_rmse);
-                    case.speedup = cells[cells.len() - 2].clone();
-                    case.pictures = ["visibility", "error", "shaded", "flip"]
-                        .iter()
-                        .map(|n| picture(n, case_dir.join(format!("{n}.png"))))
-                        .collect();
-                    html_scene.cases.push(case);
-                }
-            }
+        Ok(Self {
+            ctx,
+            dir,
+            scene,
+            curve,
+            reference,
+            ref_secs: *ref_secs,
+            reference_shaded,
+            html,
+        })
+    }
+
+    /// Writes a case's visibility, signed error, shaded and FLIP images; its FLIP.
+    fn case_images(&self, case_dir: &PathBuf, r: &CaseReport) -> Result<Flip, String> {
+        ensure_dir(case_dir)?;
+        write_visibility_png(&case_dir.join("visibility.png"), &r.estimate)
+            .map_err(|e| e.to_string())?;
+        write_error_png(&case_dir.join("error.png"), &r.estimate, &r.reference, 0.5)
+            .map_err(|e| e.to_string())?;
+        let shaded = shade(self.ctx, &r.estimate)?;
+        save(&shaded, &case_dir.join("shaded.png"))?;
+        let perceptual = flip(&self.reference_shaded, &shaded, &self.ctx.view)?;
+        save(&perceptual.map, &case_dir.join("flip.png"))?;
+        Ok(perceptual)
+    }
+
+    /// The case's RMSE against the independent reference: for a sample-based technique the
+    /// same-samples error is its own approximation only (0 for exact DCS).
+    fn independent_rmse(&self, r: &CaseReport) -> Result<f64, String> {
+        Ok(if r.same_samples {
+            compare(&r.estimate, self.reference)
+                .map_err(|e| e.to_string())?
+                .rmse
+        } else {
+            r.metrics.rmse
+        })
+    }
+}
+
+/// The scene's diffuse shading under `v`.
+fn shade(
+    ctx: &SceneContext,
+    v: &dyn shadow_core::visibility::VisibilityBuffer,
+) -> Result<image::RgbImage, String> {
+    shaded_image(ctx.setup.scene.as_ref(), &ctx.view, ctx.light().as_ref(), v)
+        .map_err(|e| e.to_string())
+}
+
+/// An empty HTML case with its status.
+fn html_case(technique: &str, status: String) -> html::Case {
+    html::Case {
+        technique: technique.to_string(),
+        status,
+        rmse: None,
+        penumbra_rmse: None,
+        flip: None,
+        seconds: None,
+        independent_rmse: None,
+        speedup: String::new(),
+        pictures: Vec::new(),
+    }
+}
+
+/// The report as it fills: the console table, `report.md`, the JSON rows, the HTML scenes.
+struct Report {
+    md: String,
+    rows: Vec<serde_json::Value>,
+    failures: Vec<String>,
+    html_scenes: Vec<html::Scene>,
+    every_light: Vec<(String, String, EveryLight)>,
+    name_width: usize,
+    scene_width: usize,
+}
+
+impl Report {
+    /// The report's header, printed and written.
+    fn new(a: &ConformanceArgs, m: &Machine, name_width: usize, scenes: &[String]) -> Self {
+        let mut md = String::new();
+        writeln!(md, "# Conformance report\n\n{} x {} pixels, reference {} samples per pixel, seed {}. Machine: {} ({} threads), {}.\n", a.width, a.height, a.ref_samples, a.seed, m.cpu, m.threads, m.date).ok();
+        writeln!(md, "Speed-up: the reference's time at the technique's RMSE against the independent reference (the stratified reference at {} samples with its own seed, never the same-samples one a sample-based technique's budget is checked against), by log-log interpolation of the reference at {CURVE:?} samples measured against the same independent reference, divided by the technique's time; `>` when the technique beats every reference run.\n", a.ref_samples).ok();
+        writeln!(md, "FLIP: the mean FLIP (NVIDIA's perceptual difference, Andersson et al. 2020, at 67 pixels per degree) of the technique's shaded image against the reference's, over the pixels holding a view sample.\n").ok();
+        writeln!(md, "| technique | scene | RMSE | penumbra RMSE | FLIP | bias | max | share > 0.1 | phases (s) | speed-up | status |\n|---|---|---|---|---|---|---|---|---|---|---|").ok();
+        // The first column fits the longest preset name, the second the longest scene name
+        // (corpus names run to 34 characters).
+        let name_width = name_width.max(9);
+        let scene_width = scenes.iter().map(String::len).max().unwrap_or(5).max(22);
+        println!(
+            "{:<name_width$} {:<scene_width$} {:>8} {:>8} {:>7} {:>8} {:>6} {:>7} {:>28} {:>9}  status",
+            "technique",
+            "scene",
+            "RMSE",
+            "pen.RMSE",
+            "FLIP",
+            "bias",
+            "max",
+            ">0.1",
+            "phases (s)",
+            "speed-up"
+        );
+        Self {
+            md,
+            rows: Vec::new(),
+            failures: Vec::new(),
+            html_scenes: Vec::new(),
+            every_light: Vec::new(),
+            name_width,
+            scene_width,
         }
-        html_scenes.push(html_scene);
     }
-    pb.finish_and_clear();
-    every_light_section(&mut md, &every_light);
-    writeln!(md, "\nImages per case in `<scene>/<technique>/`: `visibility.png`, `error.png` (signed error, blue = too dark, red = too bright, full scale 0.5), `shaded.png` and `flip.png` (FLIP's error map, magma); the reference in `<scene>/reference.png`. All of them, the table and a time-error plot per scene in `report.html`.").ok();
-    html::write_report(
-        &a.out.join("report.html"),
-        "Conformance report",
-        &format!(
-            "{} x {} pixels, reference {} samples per pixel, seed {}. Machine: {} ({} threads), {}. Images: visibility, signed error (blue too dark, red too bright, full scale 0.5), shaded, FLIP map. Click a column to sort.",
-            a.width, a.height, a.ref_samples, a.seed, m.cpu, m.threads, m.date
-        ),
-        &html_scenes,
-    )?;
-    std::fs::write(a.out.join("report.md"), md).map_err(|e| e.to_string())?;
-    write_json(
-        &a.out.join("report.json"),
-        &json!({"machine": m, "config": cfg, "cases": rows}),
-    )?;
-    println!("\nreport: {}", a.out.join("report.md").display());
-    if failures.is_empty() {
+
+    /// Records one case's outcome.
+    fn case(&mut self, name: &str, run: &mut SceneRun, outcome: Outcome) -> Result<(), String> {
+        let (nw, sw, scene) = (self.name_width, self.scene_width, run.scene);
+        match outcome {
+            Outcome::Unsupported { reason } => {
+                println!("{name:<nw$} {scene:<sw$} unsupported: {reason}");
+                writeln!(
+                    self.md,
+                    "| {name} | {scene} | | | | | | | | unsupported: {reason} |"
+                )
+                .ok();
+                self.rows.push(json!({"technique": name, "scene": scene, "status": "unsupported", "reason": reason}));
+                run.html
+                    .cases
+                    .push(html_case(name, format!("unsupported: {reason}")));
+            }
+            Outcome::Failed { error } => {
+                println!("{name:<nw$} {scene:<sw$} FAILED: {error}");
+                writeln!(
+                    self.md,
+                    "| {name} | {scene} | | | | | | | | FAILED: {error} |"
+                )
+                .ok();
+                self.failures.push(format!("{name} on {scene}: {error}"));
+                self.rows.push(
+                    json!({"technique": name, "scene": scene, "status": "failed", "error": error}),
+                );
+                run.html
+                    .cases
+                    .push(html_case(name, format!("FAILED: {error}")));
+            }
+            Outcome::Ran(r) => self.ran(name, run, &r)?,
+        }
         Ok(())
-    } else {
-        Err(format!(
-            "{} conformance failures:\n{}",
-            failures.len(),
-            failures.join("\n")
-        ))
     }
+
+    /// A case that ran: its images, its table row, its JSON row and its HTML case.
+    fn ran(&mut self, name: &str, run: &mut SceneRun, r: &CaseReport) -> Result<(), String> {
+        let scene = run.scene;
+        let case_dir = run.dir.join(name);
+        let perceptual = run.case_images(&case_dir, r)?;
+        let independent_rmse = run.independent_rmse(r)?;
+        let speedup_at_equal_error =
+            reference_time_at(&run.curve, independent_rmse).map(|t| t / r.seconds);
+        let speedup = match speedup_at_equal_error {
+            Some(x) => format!("{x:.2}x"),
+            None => format!(
+                ">{:.2}x",
+                run.curve.last().map_or(0.0, |c| c.seconds) / r.seconds
+            ),
+        };
+        for v in &r.violations {
+            self.failures.push(format!("{name} on {scene}: {v}"));
+        }
+        let cells = case_cells(name, scene, r, perceptual.mean, speedup);
+        self.print_row(&cells);
+        writeln!(self.md, "| {} |", cells.join(" | ")).ok();
+        if let Some(e) = &r.every_light {
+            self.every_light
+                .push((name.to_string(), scene.to_string(), e.clone()));
+        }
+        let mut row = serde_json::to_value(r).map_err(|e| e.to_string())?;
+        row["status"] = json!(if r.passed() { "ok" } else { "fail" });
+        row["rmse_against_independent_reference"] = json!(independent_rmse);
+        row["flip"] = json!(perceptual.mean);
+        row["speedup_at_equal_error"] = json!(speedup_at_equal_error);
+        row["reference_curve"] = json!(run.curve);
+        row["reference_seconds_high"] = json!(run.ref_secs);
+        self.rows.push(row);
+        let mut case = html_case(name, cells[cells.len() - 1].clone());
+        case.rmse = Some(r.metrics.rmse);
+        case.penumbra_rmse = r.metrics.penumbra_rmse;
+        case.flip = Some(perceptual.mean);
+        case.seconds = Some(r.seconds);
+        case.independent_rmse = Some(independent_rmse);
+        case.speedup = cells[cells.len() - 2].clone();
+        case.pictures = ["visibility", "error", "shaded", "flip"]
+            .iter()
+            .map(|n| picture(n, case_dir.join(format!("{n}.png"))))
+            .collect();
+        run.html.cases.push(case);
+        Ok(())
+    }
+
+    /// One row of the console table, its columns aligned with the header's.
+    fn print_row(&self, cells: &[String]) {
+        let widths = [
+            self.name_width,
+            self.scene_width,
+            8,
+            8,
+            7,
+            8,
+            6,
+            7,
+            28,
+            9,
+            0,
+        ];
+        let line: Vec<String> = cells
+            .iter()
+            .zip(widths)
+            .enumerate()
+            .map(|(k, (c, w))| {
+                if k < 2 {
+                    format!("{c:<w$}")
+                } else {
+                    format!("{c:>w$}")
+                }
+            })
+            .collect();
+        println!("{}", line.join(" "));
+    }
+
+    /// Writes `report.md`, `report.html` and `report.json`; an error listing the failures.
+    fn write(mut self, a: &ConformanceArgs, m: &Machine, cfg: SuiteConfig) -> Result<(), String> {
+        every_light_section(&mut self.md, &self.every_light);
+        writeln!(self.md, "\nImages per case in `<scene>/<technique>/`: `visibility.png`, `error.png` (signed error, blue = too dark, red = too bright, full scale 0.5), `shaded.png` and `flip.png` (FLIP's error map, magma); the reference in `<scene>/reference.png`. All of them, the table and a time-error plot per scene in `report.html`.").ok();
+        html::write_report(
+            &a.out.join("report.html"),
+            "Conformance report",
+            &format!(
+                "{} x {} pixels, reference {} samples per pixel, seed {}. Machine: {} ({} threads), {}. Images: visibility, signed error (blue too dark, red too bright, full scale 0.5), shaded, FLIP map. Click a column to sort.",
+                a.width, a.height, a.ref_samples, a.seed, m.cpu, m.threads, m.date
+            ),
+            &self.html_scenes,
+        )?;
+        std::fs::write(a.out.join("report.md"), self.md).map_err(|e| e.to_string())?;
+        write_json(
+            &a.out.join("report.json"),
+            &json!({"machine": m, "config": cfg, "cases": self.rows}),
+        )?;
+        println!("\nreport: {}", a.out.join("report.md").display());
+        if self.failures.is_empty() {
+            Ok(())
+        } else {
+            Err(format!(
+                "{} conformance failures:\n{}",
+                self.failures.len(),
+                self.failures.join("\n")
+            ))
+        }
+    }
+}
+
+/// A case's cells in the table: metrics, phases, speed-up and status (with its notes).
+fn case_cells(name: &str, scene: &str, r: &CaseReport, flip: f64, speedup: String) -> Vec<String> {
+    let phases = r
+        .prepare_stats
+        .phases
+        .iter()
+        .chain(&r.estimate_stats.phases)
+        .map(|ph| format!("{} {:.3}", ph.name, ph.seconds))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let status = if r.passed() {
+        "ok".to_string()
+    } else {
+        format!("FAIL: {}", r.violations.join("; "))
+    };
+    let status = if r.notes.is_empty() {
+        status
+    } else {
+        format!("{status} (note: {})", r.notes.join("; "))
+    };
+    let pen = r
+        .metrics
+        .penumbra_rmse
+        .map_or("-".to_string(), |v| format!("{v:.4}"));
+    vec![
+        name.to_string(),
+        scene.to_string(),
+        format!("{:.4}", r.metrics.rmse),
+        pen,
+        format!("{:.4}", flip),
+        format!("{:+.4}", r.metrics.bias),
+        format!("{:.3}", r.metrics.max_abs),
+        format!("{:.4}", r.metrics.share_over_0_1),
+        phases,
+        speedup,
+        status,
+    ]
 }
