@@ -31,16 +31,18 @@ use shadow_core::offset::RayOffset;
 use shadow_core::prelude::*;
 use shadow_core::sampling::hash_words;
 use shadow_core::technique::{Capabilities, Processor, SceneRef};
-use shadow_core::visibility::{PerSampleVisibility, PixelClass};
 
-use crate::frame::MapFrame;
 pub use crate::inputs::silhouette_edges;
-use crate::inputs::{casters_of, group_receivers, upload_casters};
+use crate::inputs::{casters_of, upload_casters};
 use crate::lut::PlaneLut;
-use crate::params::{Caster, LightBounds, OPAQUE, Params, Receiver, Region};
-use crate::passes::{CasterBatch, Pipelines, Shared, TALLIES, device_error, run_batch};
+use crate::params::{Caster, LightBounds, OPAQUE, Region};
+use crate::passes::{CasterBatch, Pipelines, device_error};
 use crate::sample_grid::SampleGrid;
-use crate::statistics::{AfsmCounter, AfsmGauge, AfsmPhase};
+use crate::statistics::AfsmPhase;
+
+mod estimate;
+
+pub use estimate::Run;
 
 /// How the occlusion pass finds the samples behind a plane (section 4.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -466,253 +468,8 @@ impl PreparedAfsm {
     ///
     /// # Errors
     /// [`TechniqueError::Device`] on a device failure.
-    #[expect(
-        clippy::type_complexity,
-        reason = "the estimate, its receivers and each batch's frame, regions and offsets, read by stage tests"
-    )]
-    pub fn run(
-        &self,
-        view: &ViewSamples,
-        keep_regions: bool,
-    ) -> Result<
-        (
-            Estimate,
-            Vec<Receiver>,
-            Vec<(MapFrame, Vec<Region>, Vec<u32>)>,
-        ),
-        TechniqueError,
-    > {
+    pub fn run(&self, view: &ViewSamples, keep_regions: bool) -> Result<Run, TechniqueError> {
         self.config.run(&self.p, view, keep_regions)
-    }
-}
-
-impl Afsm {
-    /// Runs the passes on `view`, keeping the last caster batch's influence regions when
-    /// `keep_regions` (for stage tests). Returns the estimate, the receivers, their map frames
-    /// and regions per batch.
-    #[expect(
-        clippy::type_complexity,
-        reason = "the estimate, its receivers and each batch's frame, regions and offsets, read by stage tests"
-    )]
-    fn run(
-        &self,
-        p: &Prepared,
-        view: &ViewSamples,
-        keep_regions: bool,
-    ) -> Result<
-        (
-            Estimate,
-            Vec<Receiver>,
-            Vec<(MapFrame, Vec<Region>, Vec<u32>)>,
-        ),
-        TechniqueError,
-    > {
-        let _gpu = p.gpu.exclusive();
-        let mut stats = Stats::default();
-        let n = self.samples;
-        let words = self.words();
-        let textured = p.light.is_textured() && !self.hard;
-        // Receivers: light front-facing view samples (section 3).
-        let (receivers, pixels, facing_away) = stats.time(AfsmPhase::Receivers, || {
-            let mut r = Vec::new();
-            let mut px = Vec::new();
-            let mut away = 0u64;
-            for i in 0..view.len() {
-                let Some(s) = view.get(i) else { continue };
-                let nrm = s.geometric_normal;
-                let origin = p.offset.offset(s.position, nrm);
-                let (_, hi_p) = p.bounds.range(nrm);
-                let above_p = hi_p - nrm.dot(s.position) > 0.0;
-                let above_o = hi_p - nrm.dot(origin) > 0.0;
-                if !(above_p && above_o) {
-                    away += 1;
-                    continue;
-                }
-                r.push(Receiver::new(
-                    origin,
-                    self.set_of(s.pixel),
-                    s.position,
-                    s.triangle,
-                    nrm,
-                ));
-                px.push(i);
-            }
-            (r, px, away)
-        });
-        let floats: Vec<f32> = receivers.iter().flat_map(|r| r.floats()).collect();
-        check_finite(&floats, "view samples").map_err(device_error)?;
-        // Batches of receivers within the binding limit.
-        let limit = self.binding_limit(&p.gpu);
-        let depths = if p.semi_opaque { n as u64 * 4 } else { 0 };
-        let per_receiver = (words as u64 * 4)
-            .max(depths)
-            .max(std::mem::size_of::<Receiver>() as u64);
-        let per_batch = (limit / per_receiver).max(1) as usize;
-        let side = view.width().max(view.height()).clamp(8, 4096);
-        let side = (1..=side)
-            .rev()
-            .find(|s| (*s as u64 * *s as u64 + 1) * 4 <= limit)
-            .unwrap_or(1);
-        let mut params = Params {
-            dims: [side, 0, n, words],
-            lut: [0, 0, 0, textured as u32],
-            ..bytemuck::Zeroable::zeroed()
-        };
-        p.bounds.write(&mut params);
-        params.center = [p.bounds.center.x, p.bounds.center.y, p.bounds.center.z, 1.0];
-        if let Some((g, grid)) = p.grid {
-            params.options[2] = g;
-            params.grid = grid;
-        }
-        if self.plane_test == PlaneTest::Lut {
-            let b = crate::lut::bins_for(n);
-            params.kind[3] = 1;
-            params.lut[..3].copy_from_slice(&b);
-        }
-        let mut values = vec![0.0f32; view.len()];
-        let mut rgbs = vec![Vec3::ZERO; if textured { view.len() } else { 0 }];
-        let wpp = n.div_ceil(64) as usize;
-        let mut bits = vec![0u64; view.len() * wpp];
-        let mut classes: Vec<PixelClass> = (0..view.len())
-            .map(|i| {
-                if view.is_valid(i) {
-                    PixelClass::Skipped
-                } else {
-                    PixelClass::Background
-                }
-            })
-            .collect();
-        // Light back-facing casters alone are exact when a receiver's segment crosses each
-        // closed mesh an even number of times: when receiver and light are on the same side of
-        // it. Every visible receiver is on the eye's side, so a closed mesh that separates the
-        // eye from the light makes every face cast.
-        let separating = view.eye().map_or(0, |e| {
-            crate::inputs::closed_meshes_between(p.scene.as_ref(), &p.closed, &p.around_light, e)
-        });
-        stats.add(
-            AfsmCounter::ClosedMeshesBetweenEyeAndLight,
-            separating as u64,
-        );
-        let casters: &[CasterBatch] = if separating > 0 {
-            let open = p.open_batches.get_or_init(|| {
-                let all_open = vec![false; p.closed.len()];
-                let casters = casters_of(p.scene.as_ref(), &all_open);
-                upload_casters(
-                    &p.gpu,
-                    &casters,
-                    Some(&p.bounds),
-                    p.per_batch,
-                    "casters, none closed",
-                )
-            });
-            open.as_ref().map_err(Clone::clone)?
-        } else {
-            &p.batches
-        };
-        let mut stages = Vec::new();
-        let (mut occupied, mut longest, mut batches) = (0u64, 0u64, 0u64);
-        let mut tallies = [0u64; TALLIES.len()];
-        let mut skipped: Vec<(AfsmCounter, u64)> = Vec::new();
-        let groups = stats.time(AfsmPhase::Frame, || {
-            group_receivers(p.bounds.center, &receivers, &pixels, per_batch, side)
-        });
-        for (chunk, chunk_px, frame) in groups {
-            batches += 1;
-            let chunk = chunk.as_slice();
-            let chunk_px = chunk_px.as_slice();
-            let mut prm = params;
-            frame.write(&mut prm);
-            check_finite(
-                bytemuck::cast_slice::<Params, f32>(std::slice::from_ref(&prm))[..32].as_ref(),
-                "light frame",
-            )
-            .map_err(device_error)?;
-            let shared = Shared {
-                casters,
-                samples: &p.samples,
-                radiance: &p.radiance,
-                lut: &p.lut,
-                semi_opaque: p.semi_opaque,
-                silhouettes: &p.silhouettes,
-                limit,
-                culling: self.culling,
-            };
-            let out = run_batch(
-                &p.gpu,
-                &p.pipes,
-                prm,
-                chunk,
-                &shared,
-                keep_regions,
-                &mut stats,
-            )
-            .map_err(device_error)?;
-            for w in out.offsets.windows(2) {
-                let len = (w[1] - w[0]) as u64;
-                occupied += (len > 0) as u64;
-                longest = longest.max(len);
-            }
-            for (k, t) in out.tallies.iter().enumerate() {
-                tallies[k] = tallies[k].saturating_add(*t);
-            }
-            for &(name, v) in &out.skipped {
-                match skipped.iter_mut().find(|(n, _)| *n == name) {
-                    Some((_, total)) => *total = total.saturating_add(v),
-                    None => skipped.push((name, v)),
-                }
-            }
-            for (j, &i) in chunk_px.iter().enumerate() {
-                let [r, g, b, count] = out.result[j];
-                values[i] = count / n as f32;
-                if textured {
-                    rgbs[i] = Vec3::new(r, g, b) / n as f32;
-                }
-                let vis = &out.visible[j * words as usize..(j + 1) * words as usize];
-                for (w, v) in vis.iter().enumerate() {
-                    bits[i * wpp + w / 2] |= (*v as u64) << (32 * (w % 2));
-                }
-                classes[i] = if count as u32 == n {
-                    PixelClass::Lit
-                } else if count == 0.0 {
-                    PixelClass::Umbra
-                } else {
-                    PixelClass::Penumbra
-                };
-            }
-            if keep_regions {
-                stages.push((frame, out.regions, out.offsets));
-            }
-        }
-        let mut vis = if textured {
-            let mut v = VisibilityImage::rgb_buffer(view);
-            v.rgbs_mut().copy_from_slice(&rgbs);
-            v
-        } else {
-            let mut v = VisibilityImage::scalar(view);
-            v.scalars_mut().copy_from_slice(&values);
-            v
-        };
-        vis.set_classes(classes)?;
-        vis.set_per_sample(PerSampleVisibility::Bits {
-            samples: n,
-            words: bits,
-        })?;
-        vis.validate()?;
-        stats.add(AfsmCounter::ReceiversListed, receivers.len() as u64);
-        stats.add(AfsmCounter::ReceiversFacingAway, facing_away);
-        stats.add(AfsmCounter::ReceiverBatches, batches);
-        stats.add(AfsmCounter::CasterBatches, casters.len() as u64);
-        stats.add(AfsmCounter::SilhouetteEdges, p.silhouette_count as u64);
-        stats.add(AfsmCounter::ListsOccupied, occupied);
-        stats.gauge_max(AfsmGauge::ListLengthMax, longest);
-        stats.gauge_max(AfsmGauge::MapSide, side as u64);
-        for (k, counter) in TALLIES.iter().enumerate() {
-            stats.add(*counter, tallies[k]);
-        }
-        for (name, v) in skipped {
-            stats.add(name, v);
-        }
-        Ok((Estimate::new(vis, stats), receivers, stages))
     }
 }
 

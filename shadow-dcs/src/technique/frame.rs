@@ -3,6 +3,7 @@
 //! scan, and the estimate and direct illumination assembled from the per-pixel pass
 //! ([`super::pixel`]).
 
+use super::output::{PixelOutput, record_counts};
 use super::pixel::PixelPass;
 use super::*;
 use crate::statistics::{DcsCounter, DcsGauge, DcsPhase};
@@ -461,46 +462,20 @@ impl Dcs {
         mut stats: Stats,
     ) -> Result<Estimate, TechniqueError> {
         let n = self.sampler.count() as usize;
-        let words = n.div_ceil(64);
+        let out = PixelOutput {
+            n,
+            words: n.div_ceil(64),
+            textured: p.light.is_textured(),
+            output,
+        };
         let w = view.width() as usize;
-        let textured = p.light.is_textured();
-        struct Row {
-            v: Vec<f32>,
-            rgb: Vec<Vec3>,
-            class: Vec<PixelClass>,
-            bits: Vec<u64>,
-            depth: Vec<u32>,
-            counts: Counts,
-        }
         let strips = stats.time(DcsPhase::DepthComplexity, || {
             self.squares(plan, |job, buffers| {
                 let rect = job.rect;
-                let m = rect.len();
                 let rw = rect.width() as usize;
-                let mut r = Row {
-                    v: vec![0.0; m],
-                    rgb: vec![Vec3::ZERO; if textured { m } else { 0 }],
-                    class: vec![PixelClass::Background; m],
-                    bits: vec![
-                        0;
-                        if output == PerSampleOutput::Bits {
-                            m * words
-                        } else {
-                            0
-                        }
-                    ],
-                    depth: vec![
-                        0;
-                        if output == PerSampleOutput::Counters {
-                            m * n
-                        } else {
-                            0
-                        }
-                    ],
-                    counts: Counts::default(),
-                };
+                let mut r = out.square(rect.len());
+                let values = out.textured || output == PerSampleOutput::Counters || p.units != 1;
                 let mut counts = Counts::default();
-                let values = textured || output == PerSampleOutput::Counters || p.units != 1;
                 self.run_square(
                     p,
                     f,
@@ -512,151 +487,15 @@ impl Dcs {
                     |i, _, class, scratch| {
                         let x =
                             (i / w - rect.rows.0 as usize) * rw + (i % w - rect.cols.0 as usize);
-                        r.class[x] = class;
-                        let vis = &scratch.vis;
-                        // Lit and umbra pixels (most of an image): every sample alike.
-                        let uniform = match class {
-                            PixelClass::Lit => Some(true),
-                            PixelClass::Umbra | PixelClass::Skipped => Some(false),
-                            _ => None,
-                        };
-                        if let (Some(lit), false, false) =
-                            (uniform, textured, output == PerSampleOutput::Counters)
-                        {
-                            r.v[x] = if lit { 1.0 } else { 0.0 };
-                            if lit && output == PerSampleOutput::Bits {
-                                for (k, word) in
-                                    r.bits[x * words..(x + 1) * words].iter_mut().enumerate()
-                                {
-                                    let left = n - k * 64;
-                                    *word = if left >= 64 {
-                                        u64::MAX
-                                    } else {
-                                        (1 << left) - 1
-                                    };
-                                }
-                            }
-                            return;
-                        }
-                        if !scratch.want_values {
-                            // Whole units, no texture, bits at most: the visible samples say all.
-                            let seen: u32 = scratch.visible.iter().map(|w| w.count_ones()).sum();
-                            r.v[x] = (f64::from(seen) / n as f64) as f32;
-                            if output == PerSampleOutput::Bits {
-                                r.bits[x * words..(x + 1) * words]
-                                    .copy_from_slice(&scratch.visible);
-                            }
-                            return;
-                        }
-                        let sum: f64 = vis.iter().map(|&v| v as f64).sum();
-                        r.v[x] = (sum / n as f64) as f32;
-                        if textured {
-                            let acc = scratch
-                                .radiances
-                                .iter()
-                                .zip(vis)
-                                .fold(Vec3::ZERO, |a, (l, v)| a + *l * *v);
-                            r.rgb[x] = acc / n as f32;
-                        }
-                        match output {
-                            PerSampleOutput::Bits => {
-                                for (k, &v) in vis.iter().enumerate() {
-                                    if v == 1.0 {
-                                        r.bits[x * words + k / 64] |= 1 << (k % 64);
-                                    }
-                                }
-                            }
-                            PerSampleOutput::Counters => {
-                                for (k, &d) in scratch.depth.iter().enumerate() {
-                                    r.depth[x * n + k] = d.min(u32::MAX as u64) as u32;
-                                }
-                            }
-                            PerSampleOutput::None => {}
-                        }
+                        out.write(&mut r, x, class, scratch);
                     },
                 );
                 r.counts = counts;
                 r
             })
         });
-        let mut vis = if textured {
-            VisibilityImage::rgb_buffer(view)
-        } else {
-            VisibilityImage::scalar(view)
-        };
-        let mut classes = vec![PixelClass::Background; view.len()];
-        let mut counts = Counts::default();
-        let mut bits = vec![
-            0u64;
-            if output == PerSampleOutput::Bits {
-                view.len() * words
-            } else {
-                0
-            }
-        ];
-        let mut depth = vec![
-            0u32;
-            if output == PerSampleOutput::Counters {
-                view.len() * n
-            } else {
-                0
-            }
-        ];
-        // Each square's rows into the image, bands of squares in parallel (a serial copy
-        // was 5 ms of a 160 ms frame on two threads).
-        if textured {
-            scatter_squares(vis.rgbs_mut(), 1, w, &strips, |r| &r.rgb);
-        } else {
-            scatter_squares(vis.scalars_mut(), 1, w, &strips, |r| &r.v);
-        }
-        scatter_squares(&mut classes, 1, w, &strips, |r| &r.class);
-        scatter_squares(&mut bits, words, w, &strips, |r| &r.bits);
-        scatter_squares(&mut depth, n, w, &strips, |r| &r.depth);
-        for (_, r) in &strips {
-            counts.add(&r.counts);
-        }
-        vis.set_classes(classes)?;
-        match output {
-            PerSampleOutput::Bits => vis.set_per_sample(PerSampleVisibility::Bits {
-                samples: n as u32,
-                words: bits,
-            })?,
-            PerSampleOutput::Counters => vis.set_per_sample(PerSampleVisibility::Counters {
-                samples: n as u32,
-                counts: depth,
-            })?,
-            PerSampleOutput::None => {}
-        }
-        stats.add(DcsCounter::PixelsFacingAway, counts.facing_away);
-        stats.add(DcsCounter::PixelsConstantOnly, counts.constant_only);
-        stats.add(DcsCounter::PixelsPerSample, counts.per_sample);
-        stats.add(DcsCounter::EdgeTests, counts.edge_tests);
-        stats.add(DcsCounter::CoveredUpdates, counts.covered_updates);
-        stats.add(DcsCounter::CounterEscalations, counts.escalations);
-        stats.add(DcsCounter::PlainCounterFallbacks, counts.plain_fallback);
-        stats.add(DcsCounter::NegativeDepthComplexity, counts.negative);
-        stats.add(DcsCounter::EdgeTies, counts.ties + counts.scan.ties);
-        stats.add(DcsCounter::WedgePixelsScanned, counts.scan.scanned);
-        stats.add(DcsCounter::WedgeExactWeights, counts.scan.exact_weights);
-        stats.add(DcsCounter::BinBlockWedges, plan.block_wedges);
-        stats.add(DcsCounter::SquaresTraced, counts.traced_squares);
-        if let Some([dcs, volumes, rays, bvh]) = plan.predicted {
-            // Whole rays: the predictions are far below u64's range.
-            stats.add(DcsCounter::PredictedDcsRays, dcs as u64);
-            stats.add(DcsCounter::PredictedShadowVolumeRays, volumes as u64);
-            stats.add(DcsCounter::PredictedTracedRays, rays as u64);
-            stats.add(DcsCounter::PredictedBvhRays, bvh as u64);
-        }
-        stats.add(DcsCounter::PixelsTraced, counts.traced_pixels);
-        stats.add(DcsCounter::OcclusionRays, counts.rays);
-        stats.add(DcsCounter::BinSquareWedges, counts.scan.square_wedges);
-        stats.add(DcsCounter::BinTileWedges, counts.scan.tile_wedges);
-        stats.add(DcsCounter::WedgePairs, counts.pairs);
-        stats.add(DcsCounter::WedgePairsOffLight, counts.off_light);
-        stats.add(DcsCounter::WedgePairsEmptySector, counts.sector_empty);
-        stats.add(DcsCounter::RefinedLineCells, counts.line_cells);
-        stats.add(DcsCounter::PixelsSharedSampleSets, counts.shared_set_pixels);
-        stats.add(DcsCounter::SharedSampleSetsBuilt, counts.shared_sets_built);
+        let (vis, counts) = out.image(view, &strips)?;
+        record_counts(&mut stats, &counts, plan.block_wedges, plan.predicted);
         vis.validate()?;
         Ok(Estimate::new(vis, stats))
     }

@@ -45,7 +45,7 @@ use shadow_core::prelude::*;
 use shadow_core::rays::{PreparedRays, RayScratch, ShadowRays};
 use shadow_core::technique::{Capabilities, Processor, SceneRef};
 use shadow_core::view_samples::ViewSample;
-use shadow_core::visibility::{PerSampleVisibility, PixelClass};
+use shadow_core::visibility::PixelClass;
 
 use crate::accel::angular::{BATCH, QuadRanges};
 use crate::accel::bins::{
@@ -65,6 +65,7 @@ use crate::stages::light_shape::LightShape;
 use crate::stages::wedges::{FOLD_SLACK, Pair};
 
 mod frame;
+mod output;
 mod pixel;
 mod rays;
 
