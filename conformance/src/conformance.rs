@@ -415,26 +415,9 @@ pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
         violations.push(format!("invalid output: {e}"));
     }
     let same = caps.sample_based && tech.light_sampler().is_some();
-    let (reference, reference_seconds) = if same {
-        let sampler = tech.light_sampler().expect("checked above").clone();
-        let r = Reference::same_samples(sampler);
-        match run_technique(&r, &ctx.setup, ctx.light(), &ctx.view) {
-            Ok((e, _, s)) => (e.visibility, s),
-            Err(e) => {
-                return Outcome::Failed {
-                    error: format!("reference: {e}"),
-                };
-            }
-        }
-    } else {
-        match ctx.reference() {
-            Ok((r, s)) => (r.clone(), *s),
-            Err(e) => {
-                return Outcome::Failed {
-                    error: format!("reference: {e}"),
-                };
-            }
-        }
+    let (reference, reference_seconds) = match case_reference(tech.as_ref(), same, ctx) {
+        Ok(r) => r,
+        Err(error) => return Outcome::Failed { error },
     };
     let metrics = match compare(&est.visibility, &reference) {
         Ok(m) => m,
@@ -452,15 +435,9 @@ pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
         mode => (preset.budget)(&format!("{}@{}", ctx.setup.name, mode.label())),
     }
     .or_else(|| (preset.budget)(&ctx.setup.name));
-    let mut notes = Vec::new();
-    if let Some(d) = shadow_auto::Decision::of(&est) {
-        notes.push(format!(
-            "chose {} ({}): predicted RMSE {:.4} in {:.4} s, achieved {:.4} in {:.4} s",
-            d.choice, d.reason, d.predicted.rmse, d.predicted.seconds, metrics.rmse, seconds,
-        ));
-    } else if let Some(d) = &est.decision {
-        notes.push(format!("chose {} ({})", d.choice(), d.reason()));
-    }
+    let mut notes: Vec<String> = decision_note(&est, metrics.rmse, seconds)
+        .into_iter()
+        .collect();
     // The budget's image: not another size, nor the same receivers as points in another
     // layout, whose light sample sets (drawn per pixel) are another draw of the tail.
     let enforce_max = (ctx.view.width(), ctx.view.height()) == BUDGET_RESOLUTION;
@@ -489,82 +466,18 @@ pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
             crate::lights::check_every_light(preset, &case, budget.as_ref(), &mut violations)
         })
         .flatten();
-    let mut deterministic = None;
-    let mut convergence = None;
-    let checks = if cfg.extra_checks {
-        match ctx.for_extra_checks(caps.processor) {
-            Ok(c) => Some(c),
-            Err(e) => {
-                violations.push(format!("extra checks: {e}"));
-                None
-            }
-        }
+    let (deterministic, convergence) = if cfg.extra_checks {
+        extra_checks(
+            preset,
+            ctx,
+            caps.processor,
+            &est,
+            &mut violations,
+            &mut notes,
+        )
     } else {
-        None
+        (None, None)
     };
-    if let Some(ctx) = checks {
-        if ctx.config != cfg {
-            notes.push(format!(
-                "determinism and convergence checked at {}x{} (GPU preset)",
-                ctx.config.width, ctx.config.height
-            ));
-        }
-        // The first run at this size: the main run, or a run on the smaller view.
-        let first = if ctx.config == cfg {
-            Ok(est.visibility.coefficients().clone())
-        } else {
-            let t = (preset.make)(cfg.seed);
-            run_technique(t.as_ref(), &ctx.setup, ctx.light(), &ctx.view)
-                .map(|(e, _, _)| e.visibility.coefficients().clone())
-        };
-        let again = (preset.make)(cfg.seed);
-        match first.and_then(|first| {
-            run_technique(again.as_ref(), &ctx.setup, ctx.light(), &ctx.view).map(|r| (first, r))
-        }) {
-            Ok((first, (e2, _, _))) => {
-                let same_output = *e2.visibility.coefficients() == first;
-                if !same_output {
-                    violations
-                        .push("not deterministic: a second run with the same seed differs".into());
-                }
-                deterministic = Some(same_output);
-            }
-            Err(e) => violations.push(format!("second run failed: {e}")),
-        }
-        if let Some(with) = preset.with_samples {
-            let rmse_at = |n: u32| -> Result<f64, String> {
-                let t = with(n, cfg.seed).map_err(|e| e.to_string())?;
-                let (e, _, _) = run_technique(t.as_ref(), &ctx.setup, ctx.light(), &ctx.view)
-                    .map_err(|e| e.to_string())?;
-                let r = if t.capabilities().sample_based {
-                    let r = Reference::stratified(cfg.ref_samples, cfg.seed ^ REFERENCE_SEED_SALT)
-                        .map_err(|e| e.to_string())?;
-                    run_technique(&r, &ctx.setup, ctx.light(), &ctx.view)
-                        .map_err(|e| e.to_string())?
-                        .0
-                        .visibility
-                } else {
-                    ctx.reference()?.0.clone()
-                };
-                compare(&e.visibility, &r)
-                    .map(|m| m.rmse)
-                    .map_err(|e| e.to_string())
-            };
-            match (rmse_at(16), rmse_at(256)) {
-                (Ok(a), Ok(b)) => {
-                    if !(b < a) && a > 1e-6 {
-                        violations.push(format!(
-                            "error does not fall with samples: rmse {a:.5} at 16, {b:.5} at 256"
-                        ));
-                    }
-                    convergence = Some((a, b));
-                }
-                (Err(e), _) | (_, Err(e)) => {
-                    violations.push(format!("convergence run failed: {e}"))
-                }
-            }
-        }
-    }
     Outcome::Ran(Box::new(CaseReport {
         technique: preset.name.to_string(),
         scene: ctx.setup.name.clone(),
@@ -585,6 +498,135 @@ pub fn run_case(preset: &Preset, ctx: &SceneContext) -> Outcome {
         estimate: est.visibility,
         reference,
     }))
+}
+
+/// The reference a case is measured against: for a sample-based technique the reference on
+/// its own light samples (its error is then its own approximation alone), else the scene's
+/// independent reference; its seconds.
+fn case_reference(
+    tech: &dyn ShadowTechnique,
+    same_samples: bool,
+    ctx: &SceneContext,
+) -> Result<(VisibilityImage, f64), String> {
+    if same_samples && let Some(sampler) = tech.light_sampler() {
+        let r = Reference::same_samples(sampler.clone());
+        return run_technique(&r, &ctx.setup, ctx.light(), &ctx.view)
+            .map(|(e, _, s)| (e.visibility, s))
+            .map_err(|e| format!("reference: {e}"));
+    }
+    match ctx.reference() {
+        Ok((r, s)) => Ok((r.clone(), *s)),
+        Err(e) => Err(format!("reference: {e}")),
+    }
+}
+
+/// What a technique that decides per view chose, against what it achieved.
+fn decision_note(est: &Estimate, rmse: f64, seconds: f64) -> Option<String> {
+    if let Some(d) = shadow_auto::Decision::of(est) {
+        return Some(format!(
+            "chose {} ({}): predicted RMSE {:.4} in {:.4} s, achieved {:.4} in {:.4} s",
+            d.choice, d.reason, d.predicted.rmse, d.predicted.seconds, rmse, seconds,
+        ));
+    }
+    est.decision
+        .as_ref()
+        .map(|d| format!("chose {} ({})", d.choice(), d.reason()))
+}
+
+/// Determinism (a second run with the same seed gives the same buffer) and convergence (the
+/// error falls from 16 to 256 samples), on the view `ctx` gives a `processor`'s extra checks.
+fn extra_checks(
+    preset: &Preset,
+    main: &SceneContext,
+    processor: Processor,
+    est: &Estimate,
+    violations: &mut Vec<String>,
+    notes: &mut Vec<String>,
+) -> (Option<bool>, Option<(f64, f64)>) {
+    let cfg = main.config;
+    let ctx = match main.for_extra_checks(processor) {
+        Ok(c) => c,
+        Err(e) => {
+            violations.push(format!("extra checks: {e}"));
+            return (None, None);
+        }
+    };
+    if ctx.config != cfg {
+        notes.push(format!(
+            "determinism and convergence checked at {}x{} (GPU preset)",
+            ctx.config.width, ctx.config.height
+        ));
+    }
+    // The first run at this size: the main run, or a run on the smaller view.
+    let first = if ctx.config == cfg {
+        Ok(est.visibility.coefficients().clone())
+    } else {
+        let t = (preset.make)(cfg.seed);
+        run_technique(t.as_ref(), &ctx.setup, ctx.light(), &ctx.view)
+            .map(|(e, _, _)| e.visibility.coefficients().clone())
+    };
+    let again = (preset.make)(cfg.seed);
+    let deterministic = match first.and_then(|first| {
+        run_technique(again.as_ref(), &ctx.setup, ctx.light(), &ctx.view).map(|r| (first, r))
+    }) {
+        Ok((first, (e2, _, _))) => {
+            let same_output = *e2.visibility.coefficients() == first;
+            if !same_output {
+                violations
+                    .push("not deterministic: a second run with the same seed differs".into());
+            }
+            Some(same_output)
+        }
+        Err(e) => {
+            violations.push(format!("second run failed: {e}"));
+            None
+        }
+    };
+    let convergence = preset.with_samples.and_then(|with| {
+        match (
+            convergence_rmse(with, ctx, 16),
+            convergence_rmse(with, ctx, 256),
+        ) {
+            (Ok(a), Ok(b)) => {
+                if !(b < a) && a > 1e-6 {
+                    violations.push(format!(
+                        "error does not fall with samples: rmse {a:.5} at 16, {b:.5} at 256"
+                    ));
+                }
+                Some((a, b))
+            }
+            (Err(e), _) | (_, Err(e)) => {
+                violations.push(format!("convergence run failed: {e}"));
+                None
+            }
+        }
+    });
+    (deterministic, convergence)
+}
+
+/// The RMSE of the preset at `n` samples against the independent reference.
+fn convergence_rmse(
+    with: fn(u32, u64) -> Result<Box<dyn ShadowTechnique>, TechniqueError>,
+    ctx: &SceneContext,
+    n: u32,
+) -> Result<f64, String> {
+    let cfg = ctx.config;
+    let t = with(n, cfg.seed).map_err(|e| e.to_string())?;
+    let (e, _, _) =
+        run_technique(t.as_ref(), &ctx.setup, ctx.light(), &ctx.view).map_err(|e| e.to_string())?;
+    let r = if t.capabilities().sample_based {
+        let r = Reference::stratified(cfg.ref_samples, cfg.seed ^ REFERENCE_SEED_SALT)
+            .map_err(|e| e.to_string())?;
+        run_technique(&r, &ctx.setup, ctx.light(), &ctx.view)
+            .map_err(|e| e.to_string())?
+            .0
+            .visibility
+    } else {
+        ctx.reference()?.0.clone()
+    };
+    compare(&e.visibility, &r)
+        .map(|m| m.rmse)
+        .map_err(|e| e.to_string())
 }
 
 /// One point of the reference's time-error curve.

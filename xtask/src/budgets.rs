@@ -24,7 +24,7 @@ use std::path::PathBuf;
 use clap::Args;
 use glam::Vec3;
 use serde::Serialize;
-use shadow_auto::{AutoModel, Config, Observation};
+use shadow_auto::{AutoModel, Config, Features, Observation};
 use shadow_conformance::conformance::{CurvePoint, reference_time_at};
 use shadow_core::prelude::*;
 use shadow_core::technique::{direct_from_per_sample, ratio_direct_from_per_sample};
@@ -36,7 +36,7 @@ use shadow_ref::{AdaptiveReference, Reference};
 use shadow_scenes::{BUILTIN_SCENES, builtin};
 
 use crate::auto_study::{self, SceneRun, timed};
-use crate::common::{machine, progress, write_json};
+use crate::common::{Machine, machine, progress, write_json};
 use crate::ensure_dir;
 
 #[derive(Args)]
@@ -167,8 +167,7 @@ pub fn run(a: BudgetsArgs) -> Result<(), String> {
     let pb = progress(scenes.len() as u64, "budgets");
     let mut studies = Vec::new();
     let mut contexts = Vec::new();
-    let mut observations: Vec<Observation> = Vec::new();
-    let mut probes = Vec::new();
+    let mut auto = AutoData::default();
     for name in &scenes {
         pb.set_message(format!("{name}: ground truth"));
         let setup = builtin(name).map_err(|e| e.to_string())?;
@@ -179,70 +178,9 @@ pub fn run(a: BudgetsArgs) -> Result<(), String> {
             a.height,
         )
         .map_err(|e| e.to_string())?;
-        let light = setup.lights[0].clone();
-        // The truth: another seed, 4096 samples, with eq. 6 from the same samples.
-        let truth = Reference::stratified(4096, 0xfeed).map_err(|e| e.to_string())?;
-        let prepared = truth
-            .prepare(setup.scene.clone(), light.clone())
-            .map_err(|e| e.to_string())?;
-        let outputs = Outputs {
-            per_sample: false,
-            direct: true,
-        };
-        let truth = prepared
-            .estimate(&view, outputs)
-            .map_err(|e| e.to_string())?;
-        let truth_direct = truth.direct.clone().ok_or("no direct light")?;
-        pb.set_message(format!("{name}: uniform"));
-        let mut uniform = Vec::new();
-        for &n in &UNIFORM {
-            let r = Reference::stratified(n, 1).map_err(|e| e.to_string())?;
-            let (secs, e) = timed(&r, &setup, &view, a.repeats)?;
-            let mt = compare(&e.visibility, &truth.visibility).map_err(|e| e.to_string())?;
-            uniform.push(CurvePoint {
-                samples: n,
-                rmse: mt.rmse,
-                seconds: secs,
-            });
-        }
-        pb.set_message(format!("{name}: adaptive"));
-        let mut adaptive = Vec::new();
-        for &target in &TARGETS {
-            let r = AdaptiveReference::new(target, DEFAULT_BATCH, DEFAULT_CAP, 1)
-                .map_err(|e| e.to_string())?;
-            let (secs, e) = timed(&r, &setup, &view, a.repeats)?;
-            let mt = compare(&e.visibility, &truth.visibility).map_err(|e| e.to_string())?;
-            let samples = e.stats.counter(RefCounter::AdaptiveSamples).unwrap_or(0);
-            let pixels = e.stats.counter(RefCounter::Pixels).unwrap_or(1).max(1);
-            adaptive.push(AdaptivePoint {
-                target,
-                rmse: mt.rmse,
-                seconds: secs,
-                mean_samples: samples as f64 / pixels as f64,
-                max_samples: e.stats.gauge(RefGauge::AdaptiveMaxSamplesPerPixel),
-                speedup: reference_time_at(&uniform, mt.rmse).map(|t| t / secs),
-            });
-        }
-        let curve = |pts: Vec<(f64, f64)>| {
-            let mut p = pts;
-            p.sort_by(|x, y| y.0.total_cmp(&x.0));
-            p
-        };
-        let u = curve(uniform.iter().map(|p| (p.rmse, p.seconds)).collect());
-        let ad = curve(adaptive.iter().map(|p| (p.rmse, p.seconds)).collect());
-        let speedup_at_0_003 = match (time_at(&u, COMPARE_AT), time_at(&ad, COMPARE_AT)) {
-            (Some(tu), Some(ta)) => Some(tu / ta),
-            _ => None,
-        };
-        let worst_rmse_over_target = adaptive
-            .iter()
-            .map(|p| p.rmse / f64::from(p.target))
-            .fold(0.0, f64::max);
-        let allocation_bound = AdaptiveReference::new(0.01, DEFAULT_BATCH, DEFAULT_CAP, 1)
-            .and_then(|r| r.prepare_adaptive(setup.scene.clone(), light.clone()))
-            .map_err(|e| e.to_string())?
-            .probe_view(&view)
-            .allocation_gain;
+        let truth = truth_of(&setup, &view)?;
+        pb.set_message(format!("{name}: uniform and adaptive"));
+        let study = study_scene(&a, name, &setup, &view, &truth)?;
         if !a.no_auto {
             pb.set_message(format!("{name}: auto observations"));
             let run = SceneRun {
@@ -251,65 +189,9 @@ pub fn run(a: BudgetsArgs) -> Result<(), String> {
                 view: &view,
                 truth: &truth.visibility,
             };
-            let f = auto_study::features(&run, a.repeats)?;
-            for p in &uniform {
-                observations.push(Observation {
-                    scene: name.clone(),
-                    features: f,
-                    config: Config::Ref { samples: p.samples },
-                    rmse: p.rmse,
-                    seconds: p.seconds,
-                });
-            }
-            // Target 0.001 is below the 4096-sample truth's own error: not a candidate.
-            for p in adaptive.iter().filter(|p| p.target >= 0.002) {
-                observations.push(Observation {
-                    scene: name.clone(),
-                    features: f,
-                    config: Config::RefAdaptive { target: p.target },
-                    rmse: p.rmse,
-                    seconds: p.seconds,
-                });
-            }
-            observations.extend(auto_study::observe_extra(&run, &f, a.repeats)?);
-            probes.push(f);
+            auto.observe(&run, &study, a.repeats)?;
         }
-        pb.set_message(format!("{name}: direct light"));
-        let mut direct = Vec::new();
-        let mut sources: Vec<(String, Box<dyn ShadowTechnique>)> = Vec::new();
-        for n in [16, 64] {
-            let r = Reference::stratified(n, 1)
-                .map_err(|e| e.to_string())?
-                .with_per_sample(true);
-            sources.push((format!("ref-{n}"), Box::new(r)));
-        }
-        if let Ok(p) = shadow_presets::preset("dcs-64") {
-            sources.push(("dcs-64".into(), (p.make)(1)));
-        }
-        for (label, t) in sources {
-            let caps = t.capabilities();
-            if caps.check(setup.scene.as_ref(), light.as_ref()).is_err() {
-                continue;
-            }
-            let samples = t.light_sampler().map_or(0, |s| s.count());
-            if let Some((eq6, ratio)) = direct_pair(t.as_ref(), &setup, &view)? {
-                direct.push(DirectRow {
-                    source: label,
-                    samples,
-                    eq6_rmse: rgb_rmse(&view, &eq6, &truth_direct),
-                    ratio_rmse: rgb_rmse(&view, &ratio, &truth_direct),
-                });
-            }
-        }
-        studies.push(SceneStudy {
-            scene: name.clone(),
-            uniform,
-            adaptive,
-            speedup_at_0_003,
-            worst_rmse_over_target,
-            allocation_bound,
-            direct,
-        });
+        studies.push(study);
         contexts.push((name.clone(), setup, view, truth.visibility));
         pb.inc(1);
     }
@@ -317,9 +199,205 @@ pub fn run(a: BudgetsArgs) -> Result<(), String> {
     let mut md = markdown(&studies, &a, &m);
     let mut auto_runs = Vec::new();
     if !a.no_auto {
+        auto_runs = auto.fit_and_evaluate(&a, &m, &scenes, &contexts)?;
+        md.push_str(&auto_study::markdown(&auto_runs));
+    }
+    std::fs::write(a.out.join("budgets.md"), &md).map_err(|e| e.to_string())?;
+    write_json(
+        &a.out.join("budgets.json"),
+        &serde_json::json!({
+            "machine": m,
+            "width": a.width,
+            "height": a.height,
+            "scenes": studies,
+            "auto_observations": auto.observations,
+            "auto_runs": auto_runs,
+        }),
+    )?;
+    print!("{md}");
+    Ok(())
+}
+
+/// The truth: another seed, 4096 samples, with eq. 6 from the same samples.
+fn truth_of(setup: &SceneSetup, view: &ViewSamples) -> Result<Estimate, String> {
+    let truth = Reference::stratified(4096, 0xfeed).map_err(|e| e.to_string())?;
+    let prepared = truth
+        .prepare(setup.scene.clone(), setup.lights[0].clone())
+        .map_err(|e| e.to_string())?;
+    let outputs = Outputs {
+        per_sample: false,
+        direct: true,
+    };
+    let est = prepared
+        .estimate(view, outputs)
+        .map_err(|e| e.to_string())?;
+    if est.direct.is_none() {
+        return Err("no direct light".into());
+    }
+    Ok(est)
+}
+
+/// One scene's study: the uniform and adaptive references against the truth, and direct
+/// light by eq. 6 and by the ratio estimator.
+fn study_scene(
+    a: &BudgetsArgs,
+    name: &str,
+    setup: &SceneSetup,
+    view: &ViewSamples,
+    truth: &Estimate,
+) -> Result<SceneStudy, String> {
+    let mut uniform = Vec::new();
+    for &n in &UNIFORM {
+        let r = Reference::stratified(n, 1).map_err(|e| e.to_string())?;
+        let (secs, e) = timed(&r, setup, view, a.repeats)?;
+        let mt = compare(&e.visibility, &truth.visibility).map_err(|e| e.to_string())?;
+        uniform.push(CurvePoint {
+            samples: n,
+            rmse: mt.rmse,
+            seconds: secs,
+        });
+    }
+    let mut adaptive = Vec::new();
+    for &target in &TARGETS {
+        let r = AdaptiveReference::new(target, DEFAULT_BATCH, DEFAULT_CAP, 1)
+            .map_err(|e| e.to_string())?;
+        let (secs, e) = timed(&r, setup, view, a.repeats)?;
+        let mt = compare(&e.visibility, &truth.visibility).map_err(|e| e.to_string())?;
+        let samples = e.stats.counter(RefCounter::AdaptiveSamples).unwrap_or(0);
+        let pixels = e.stats.counter(RefCounter::Pixels).unwrap_or(1).max(1);
+        adaptive.push(AdaptivePoint {
+            target,
+            rmse: mt.rmse,
+            seconds: secs,
+            mean_samples: samples as f64 / pixels as f64,
+            max_samples: e.stats.gauge(RefGauge::AdaptiveMaxSamplesPerPixel),
+            speedup: reference_time_at(&uniform, mt.rmse).map(|t| t / secs),
+        });
+    }
+    let curve = |pts: Vec<(f64, f64)>| {
+        let mut p = pts;
+        p.sort_by(|x, y| y.0.total_cmp(&x.0));
+        p
+    };
+    let u = curve(uniform.iter().map(|p| (p.rmse, p.seconds)).collect());
+    let ad = curve(adaptive.iter().map(|p| (p.rmse, p.seconds)).collect());
+    let speedup_at_0_003 = match (time_at(&u, COMPARE_AT), time_at(&ad, COMPARE_AT)) {
+        (Some(tu), Some(ta)) => Some(tu / ta),
+        _ => None,
+    };
+    let worst_rmse_over_target = adaptive
+        .iter()
+        .map(|p| p.rmse / f64::from(p.target))
+        .fold(0.0, f64::max);
+    let allocation_bound = AdaptiveReference::new(0.01, DEFAULT_BATCH, DEFAULT_CAP, 1)
+        .and_then(|r| r.prepare_adaptive(setup.scene.clone(), setup.lights[0].clone()))
+        .map_err(|e| e.to_string())?
+        .probe_view(view)
+        .allocation_gain;
+    let truth_direct = truth.direct.as_ref().ok_or("no direct light")?;
+    Ok(SceneStudy {
+        scene: name.to_string(),
+        uniform,
+        adaptive,
+        speedup_at_0_003,
+        worst_rmse_over_target,
+        allocation_bound,
+        direct: direct_rows(setup, view, truth_direct)?,
+    })
+}
+
+/// Direct light by eq. 6 and by the ratio estimator from the references' and DCS's
+/// per-sample visibility, each against the truth's.
+fn direct_rows(
+    setup: &SceneSetup,
+    view: &ViewSamples,
+    truth_direct: &[Vec3],
+) -> Result<Vec<DirectRow>, String> {
+    let light = &setup.lights[0];
+    let mut direct = Vec::new();
+    let mut sources: Vec<(String, Box<dyn ShadowTechnique>)> = Vec::new();
+    for n in [16, 64] {
+        let r = Reference::stratified(n, 1)
+            .map_err(|e| e.to_string())?
+            .with_per_sample(true);
+        sources.push((format!("ref-{n}"), Box::new(r)));
+    }
+    if let Ok(p) = shadow_presets::preset("dcs-64") {
+        sources.push(("dcs-64".into(), (p.make)(1)));
+    }
+    for (label, t) in sources {
+        let caps = t.capabilities();
+        if caps.check(setup.scene.as_ref(), light.as_ref()).is_err() {
+            continue;
+        }
+        let samples = t.light_sampler().map_or(0, |s| s.count());
+        if let Some((eq6, ratio)) = direct_pair(t.as_ref(), setup, view)? {
+            direct.push(DirectRow {
+                source: label,
+                samples,
+                eq6_rmse: rgb_rmse(view, &eq6, truth_direct),
+                ratio_rmse: rgb_rmse(view, &ratio, truth_direct),
+            });
+        }
+    }
+    Ok(direct)
+}
+
+/// What `auto`'s models are fitted on: every configuration's observed error and time per
+/// scene, and each scene's probe features.
+#[derive(Default)]
+struct AutoData {
+    observations: Vec<Observation>,
+    probes: Vec<Features>,
+}
+
+impl AutoData {
+    /// The scene's features, the study's uniform and adaptive points as observations, and
+    /// the other candidates observed.
+    fn observe(
+        &mut self,
+        run: &SceneRun,
+        study: &SceneStudy,
+        repeats: usize,
+    ) -> Result<(), String> {
+        let f = auto_study::features(run, repeats)?;
+        for p in &study.uniform {
+            self.observations.push(Observation {
+                scene: run.name.to_string(),
+                features: f,
+                config: Config::Ref { samples: p.samples },
+                rmse: p.rmse,
+                seconds: p.seconds,
+            });
+        }
+        // Target 0.001 is below the 4096-sample truth's own error: not a candidate.
+        for p in study.adaptive.iter().filter(|p| p.target >= 0.002) {
+            self.observations.push(Observation {
+                scene: run.name.to_string(),
+                features: f,
+                config: Config::RefAdaptive { target: p.target },
+                rmse: p.rmse,
+                seconds: p.seconds,
+            });
+        }
+        self.observations
+            .extend(auto_study::observe_extra(run, &f, repeats)?);
+        self.probes.push(f);
+        Ok(())
+    }
+
+    /// Fits the models (written when `--write-model` asks) and evaluates `auto` on every
+    /// scene against them.
+    fn fit_and_evaluate(
+        &self,
+        a: &BudgetsArgs,
+        m: &Machine,
+        scenes: &[String],
+        contexts: &[(String, SceneSetup, ViewSamples, VisibilityImage)],
+    ) -> Result<Vec<auto_study::AutoRun>, String> {
         let model = AutoModel::fit(
-            &observations,
-            &probes,
+            &self.observations,
+            &self.probes,
             auto_study::PROBE_PIXELS,
             auto_study::ERROR_QUANTILE,
             serde_json::json!({
@@ -342,23 +420,8 @@ pub fn run(a: BudgetsArgs) -> Result<(), String> {
                 truth,
             })
             .collect();
-        auto_runs = auto_study::evaluate(&runs, &observations, &probes, a.repeats)?;
-        md.push_str(&auto_study::markdown(&auto_runs));
+        auto_study::evaluate(&runs, &self.observations, &self.probes, a.repeats)
     }
-    std::fs::write(a.out.join("budgets.md"), &md).map_err(|e| e.to_string())?;
-    write_json(
-        &a.out.join("budgets.json"),
-        &serde_json::json!({
-            "machine": m,
-            "width": a.width,
-            "height": a.height,
-            "scenes": studies,
-            "auto_observations": observations,
-            "auto_runs": auto_runs,
-        }),
-    )?;
-    print!("{md}");
-    Ok(())
 }
 
 fn fmt_opt(v: Option<f64>, digits: usize) -> String {
