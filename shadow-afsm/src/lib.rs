@@ -51,6 +51,7 @@
 
 #![deny(missing_docs)]
 
+mod batch;
 pub mod frame;
 pub mod influence;
 mod inputs;

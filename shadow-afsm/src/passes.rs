@@ -24,10 +24,9 @@
 use shadow_core::gpu::{Encoder, GpuContext, GpuError};
 use shadow_core::technique::Stats;
 
-use crate::params::{Params, Receiver, Region};
+use crate::params::Params;
 pub use crate::pipelines::{COMMON, MODULES, OCCUPIED, Pipelines, TALLY, TILING, VOLUME, source};
 use crate::statistics::{AfsmCounter, AfsmPhase};
-use glam::Vec3;
 
 /// A device failure as a technique error.
 pub(crate) fn device_error(e: GpuError) -> shadow_core::technique::TechniqueError {
@@ -43,7 +42,7 @@ fn pairs_per_invocation(words: u32) -> u32 {
 /// Runs `phase` of `stats` (wall-clock time from submission to completion, readbacks
 /// included) and, where the device has timestamp queries, adds the device time of its passes
 /// to the phase's device seconds.
-fn timed<T>(
+pub(crate) fn timed<T>(
     gpu: &GpuContext,
     stats: &mut Stats,
     phase: AfsmPhase,
@@ -121,7 +120,7 @@ pub struct Shared<'a> {
 
 /// What a range of tiled regions is for.
 #[derive(Clone, Copy)]
-enum Work<'a> {
+pub(crate) enum Work<'a> {
     /// Occlusion by these casters.
     Occlude(&'a CasterBatch),
     /// The silhouette stencil from these edges' regions.
@@ -137,7 +136,7 @@ const TILE_SLOT: usize = 7;
 const PAIR_SLOT: usize = 8;
 /// The tallies of work skipped, kept over every range: cluster culling's (`tile_pairs.wgsl`)
 /// and the pairs whose view sample was already hidden from every light sample (`occlude.wgsl`).
-const SKIPPED_SLOTS: [(usize, AfsmCounter); 10] = [
+pub(crate) const SKIPPED_SLOTS: [(usize, AfsmCounter); 10] = [
     (9, AfsmCounter::TilesCulled),
     (10, AfsmCounter::TexelsCulledByDepth),
     (11, AfsmCounter::PairsAfterUmbra),
@@ -150,34 +149,34 @@ const SKIPPED_SLOTS: [(usize, AfsmCounter); 10] = [
     (18, AfsmCounter::CastersCulled),
 ];
 /// Tallies buffer length in u32 words (nineteen 64-bit slots).
-const TALLY_WORDS: usize = 38;
+pub(crate) const TALLY_WORDS: usize = 38;
 
 /// The buffers one batch of view samples shares between its caster ranges.
-struct Occlusion<'a> {
-    gpu: &'a GpuContext,
-    pipes: &'a Pipelines,
-    shared: &'a Shared<'a>,
-    regions: &'a wgpu::Buffer,
-    receivers: &'a wgpu::Buffer,
-    offsets: &'a wgpu::Buffer,
-    lists: &'a wgpu::Buffer,
-    masks: &'a wgpu::Buffer,
-    tallies: &'a wgpu::Buffer,
-    flags: &'a wgpu::Buffer,
-    depths: &'a wgpu::Buffer,
-    tile_depth: &'a wgpu::Buffer,
-    texel_depth: &'a wgpu::Buffer,
-    tile_box: &'a wgpu::Buffer,
-    texel_near: &'a wgpu::Buffer,
-    tile_near: &'a wgpu::Buffer,
-    occupancy: &'a wgpu::Buffer,
-    super_bounds: &'a wgpu::Buffer,
-    texel_bits: &'a wgpu::Buffer,
-    batch_box: &'a wgpu::Buffer,
-    slots: &'a wgpu::Buffer,
-    texel_hidden: &'a wgpu::Buffer,
-    tile_count: &'a wgpu::Buffer,
-    tile_hidden: &'a wgpu::Buffer,
+pub(crate) struct Occlusion<'a> {
+    pub(crate) gpu: &'a GpuContext,
+    pub(crate) pipes: &'a Pipelines,
+    pub(crate) shared: &'a Shared<'a>,
+    pub(crate) regions: &'a wgpu::Buffer,
+    pub(crate) receivers: &'a wgpu::Buffer,
+    pub(crate) offsets: &'a wgpu::Buffer,
+    pub(crate) lists: &'a wgpu::Buffer,
+    pub(crate) masks: &'a wgpu::Buffer,
+    pub(crate) tallies: &'a wgpu::Buffer,
+    pub(crate) flags: &'a wgpu::Buffer,
+    pub(crate) depths: &'a wgpu::Buffer,
+    pub(crate) tile_depth: &'a wgpu::Buffer,
+    pub(crate) texel_depth: &'a wgpu::Buffer,
+    pub(crate) tile_box: &'a wgpu::Buffer,
+    pub(crate) texel_near: &'a wgpu::Buffer,
+    pub(crate) tile_near: &'a wgpu::Buffer,
+    pub(crate) occupancy: &'a wgpu::Buffer,
+    pub(crate) super_bounds: &'a wgpu::Buffer,
+    pub(crate) texel_bits: &'a wgpu::Buffer,
+    pub(crate) batch_box: &'a wgpu::Buffer,
+    pub(crate) slots: &'a wgpu::Buffer,
+    pub(crate) texel_hidden: &'a wgpu::Buffer,
+    pub(crate) tile_count: &'a wgpu::Buffer,
+    pub(crate) tile_hidden: &'a wgpu::Buffer,
 }
 
 impl Occlusion<'_> {
@@ -188,7 +187,7 @@ impl Occlusion<'_> {
     }
 
     /// Influence regions of `batch`, then its tiled work.
-    fn batch(
+    pub(crate) fn batch(
         &self,
         params: Params,
         batch: &CasterBatch,
@@ -279,34 +278,14 @@ impl Occlusion<'_> {
         stats: &mut Stats,
     ) -> Result<(), GpuError> {
         let gpu = self.gpu;
-        let pipes = self.pipes;
         let mut p = params;
         p.work = [base, count, 0, 0];
-        let mut keep = Vec::new();
-        let tile_counts = gpu.storage_zeroed("tile counts", (count as u64 + 1) * 4)?;
-        let caster_masks = gpu.storage_zeroed("kept super-tiles", count as u64 * 12)?;
-        let tiles = timed(gpu, stats, AfsmPhase::GpuTiles, || {
-            let uni = gpu.uniform("params", &p);
-            let mut enc = gpu.encoder();
-            enc.clear_buffer(self.tallies, 4 * 2 * TILE_SLOT as u64, Some(16));
-            let b = gpu.bind(
-                &pipes.tiles,
-                &[
-                    &uni,
-                    self.regions,
-                    &tile_counts,
-                    self.tallies,
-                    self.occupancy,
-                    &caster_masks,
-                    volumes,
-                    self.super_bounds,
-                ],
-            );
-            gpu.dispatch(&mut enc, &pipes.tiles, &b, (count as u64).div_ceil(64))?;
-            scan(gpu, pipes, &mut enc, &tile_counts, count + 1, &mut keep)?;
-            gpu.submit(enc)?;
-            self.tally(TILE_SLOT)
-        })?;
+        let mut r = RangeBuffers {
+            tile_counts: gpu.storage_zeroed("tile counts", (count as u64 + 1) * 4)?,
+            caster_masks: gpu.storage_zeroed("kept super-tiles", count as u64 * 12)?,
+            keep: Vec::new(),
+        };
+        let tiles = self.number_tiles(&p, volumes, &mut r, count, stats)?;
         if let Work::Occlude(_) = work {
             stats.add(AfsmCounter::TilesNumbered, tiles);
         }
@@ -333,71 +312,12 @@ impl Occlusion<'_> {
         p.work[2] = tiles as u32;
         let batch = match work {
             Work::Occlude(batch) => batch,
-            Work::Stencil => {
-                return timed(gpu, stats, AfsmPhase::GpuStencil, || {
-                    let uni = gpu.uniform("params", &p);
-                    let mut enc = gpu.encoder();
-                    let b = gpu.bind(
-                        &pipes.stencil,
-                        &[
-                            &uni,
-                            self.regions,
-                            &tile_counts,
-                            self.offsets,
-                            self.flags,
-                            self.occupancy,
-                            &caster_masks,
-                        ],
-                    );
-                    gpu.dispatch(&mut enc, &pipes.stencil, &b, tiles.div_ceil(64))?;
-                    gpu.submit(enc)
-                });
-            }
+            Work::Stencil => return self.stencil(&p, &r, tiles, stats),
         };
-        // Pair counts (scanned in place), then two words of overlap mask per tile. The tallies
-        // are kept aside in case the range must be split and its tiles counted again.
-        let pair_counts = gpu.storage_zeroed("pair counts", (3 * tiles + 1) * 4)?;
+        // The tallies are kept aside in case the range must be split and its tiles counted
+        // again.
         let saved = gpu.storage_zeroed("saved tallies", TALLY_WORDS as u64 * 4)?;
-        let pairs = timed(gpu, stats, AfsmPhase::GpuTiles, || {
-            let uni = gpu.uniform("params", &p);
-            let mut enc = gpu.encoder();
-            enc.copy_buffer_to_buffer(self.tallies, 0, &saved, 0, TALLY_WORDS as u64 * 4);
-            let b = gpu.bind(
-                &pipes.tile_pairs,
-                &[
-                    &uni,
-                    self.regions,
-                    &tile_counts,
-                    self.offsets,
-                    &pair_counts,
-                    self.tallies,
-                    &batch.buffer,
-                    self.tile_depth,
-                    self.texel_depth,
-                    self.tile_box,
-                    self.texel_hidden,
-                    self.tile_count,
-                    self.tile_hidden,
-                    &batch.volumes,
-                    self.texel_near,
-                    self.tile_near,
-                    self.occupancy,
-                    &caster_masks,
-                    self.texel_bits,
-                ],
-            );
-            gpu.dispatch(&mut enc, &pipes.tile_pairs, &b, tiles.div_ceil(64))?;
-            scan(
-                gpu,
-                pipes,
-                &mut enc,
-                &pair_counts,
-                tiles as u32 + 1,
-                &mut keep,
-            )?;
-            gpu.submit(enc)?;
-            self.tally(PAIR_SLOT)
-        })?;
+        let (pairs, pair_counts) = self.pair_tiles(&p, batch, &mut r, &saved, tiles, stats)?;
         if pairs >= u32::MAX as u64 {
             // The running sum of pair counts is 32-bit: count the halves apart.
             let half = count / 2;
@@ -418,18 +338,153 @@ impl Occlusion<'_> {
             return Ok(());
         }
         p.work[3] = pairs as u32;
-        let groups = pairs.div_ceil(64 * pairs_per_invocation(params.dims[3]) as u64);
+        self.occlude(&p, batch, &r, &pair_counts, pairs, stats)
+    }
+
+    /// Numbers the tiles each caster of the range overlaps (`tiles.wgsl`, scanned); their
+    /// count.
+    fn number_tiles(
+        &self,
+        p: &Params,
+        volumes: &wgpu::Buffer,
+        r: &mut RangeBuffers,
+        count: u32,
+        stats: &mut Stats,
+    ) -> Result<u64, GpuError> {
+        let (gpu, pipes) = (self.gpu, self.pipes);
+        timed(gpu, stats, AfsmPhase::GpuTiles, || {
+            let uni = gpu.uniform("params", p);
+            let mut enc = gpu.encoder();
+            enc.clear_buffer(self.tallies, 4 * 2 * TILE_SLOT as u64, Some(16));
+            let b = gpu.bind(
+                &pipes.tiles,
+                &[
+                    &uni,
+                    self.regions,
+                    &r.tile_counts,
+                    self.tallies,
+                    self.occupancy,
+                    &r.caster_masks,
+                    volumes,
+                    self.super_bounds,
+                ],
+            );
+            gpu.dispatch(&mut enc, &pipes.tiles, &b, (count as u64).div_ceil(64))?;
+            scan(gpu, pipes, &mut enc, &r.tile_counts, count + 1, &mut r.keep)?;
+            gpu.submit(enc)?;
+            self.tally(TILE_SLOT)
+        })
+    }
+
+    /// The silhouette stencil (section 4.3) over the range's tiles.
+    fn stencil(
+        &self,
+        p: &Params,
+        r: &RangeBuffers,
+        tiles: u64,
+        stats: &mut Stats,
+    ) -> Result<(), GpuError> {
+        let (gpu, pipes) = (self.gpu, self.pipes);
+        timed(gpu, stats, AfsmPhase::GpuStencil, || {
+            let uni = gpu.uniform("params", p);
+            let mut enc = gpu.encoder();
+            let b = gpu.bind(
+                &pipes.stencil,
+                &[
+                    &uni,
+                    self.regions,
+                    &r.tile_counts,
+                    self.offsets,
+                    self.flags,
+                    self.occupancy,
+                    &r.caster_masks,
+                ],
+            );
+            gpu.dispatch(&mut enc, &pipes.stencil, &b, tiles.div_ceil(64))?;
+            gpu.submit(enc)
+        })
+    }
+
+    /// Pair counts per tile (`tile_pairs.wgsl`, with cluster culling; scanned in place), then
+    /// two words of overlap mask per tile; the tallies are first copied to `saved`. The
+    /// range's pair count and the scanned pair counts.
+    fn pair_tiles(
+        &self,
+        p: &Params,
+        batch: &CasterBatch,
+        r: &mut RangeBuffers,
+        saved: &wgpu::Buffer,
+        tiles: u64,
+        stats: &mut Stats,
+    ) -> Result<(u64, wgpu::Buffer), GpuError> {
+        let (gpu, pipes) = (self.gpu, self.pipes);
+        let pair_counts = gpu.storage_zeroed("pair counts", (3 * tiles + 1) * 4)?;
+        let pairs = timed(gpu, stats, AfsmPhase::GpuTiles, || {
+            let uni = gpu.uniform("params", p);
+            let mut enc = gpu.encoder();
+            enc.copy_buffer_to_buffer(self.tallies, 0, saved, 0, TALLY_WORDS as u64 * 4);
+            let b = gpu.bind(
+                &pipes.tile_pairs,
+                &[
+                    &uni,
+                    self.regions,
+                    &r.tile_counts,
+                    self.offsets,
+                    &pair_counts,
+                    self.tallies,
+                    &batch.buffer,
+                    self.tile_depth,
+                    self.texel_depth,
+                    self.tile_box,
+                    self.texel_hidden,
+                    self.tile_count,
+                    self.tile_hidden,
+                    &batch.volumes,
+                    self.texel_near,
+                    self.tile_near,
+                    self.occupancy,
+                    &r.caster_masks,
+                    self.texel_bits,
+                ],
+            );
+            gpu.dispatch(&mut enc, &pipes.tile_pairs, &b, tiles.div_ceil(64))?;
+            scan(
+                gpu,
+                pipes,
+                &mut enc,
+                &pair_counts,
+                tiles as u32 + 1,
+                &mut r.keep,
+            )?;
+            gpu.submit(enc)?;
+            self.tally(PAIR_SLOT)
+        })?;
+        Ok((pairs, pair_counts))
+    }
+
+    /// The occlusion pass (`occlude.wgsl`, section 4.2) over the range's `pairs`.
+    fn occlude(
+        &self,
+        p: &Params,
+        batch: &CasterBatch,
+        r: &RangeBuffers,
+        pair_counts: &wgpu::Buffer,
+        pairs: u64,
+        stats: &mut Stats,
+    ) -> Result<(), GpuError> {
+        let (gpu, pipes) = (self.gpu, self.pipes);
+        let groups = pairs.div_ceil(64 * pairs_per_invocation(p.dims[3]) as u64);
         timed(gpu, stats, AfsmPhase::GpuOcclude, || {
-            let uni = gpu.uniform("params", &p);
+            let uni = gpu.uniform("params", p);
             let mut enc = gpu.encoder();
             let b = gpu.bind(
                 &pipes.occlude,
                 &[
                     &uni,
                     self.regions,
-                    &tile_counts,
+                    &r.tile_counts,
                     self.offsets,
-                    &pair_counts,
+                    pair_counts,
                     &batch.buffer,
                     self.receivers,
                     self.lists,
@@ -440,13 +495,23 @@ impl Occlusion<'_> {
                     self.flags,
                     self.depths,
                     self.occupancy,
-                    &caster_masks,
+                    &r.caster_masks,
                 ],
             );
             gpu.dispatch(&mut enc, &pipes.occlude, &b, groups)?;
             gpu.submit(enc)
         })
     }
+}
+
+/// The buffers one caster range's passes share.
+struct RangeBuffers {
+    /// Tiles per caster, scanned into offsets.
+    tile_counts: wgpu::Buffer,
+    /// The super-tiles each caster keeps after culling.
+    caster_masks: wgpu::Buffer,
+    /// Scan buffers that must outlive the submission.
+    keep: Vec<wgpu::Buffer>,
 }
 
 /// Occlusion-pass tallies, in the order the shader keeps them.
@@ -459,237 +524,3 @@ pub const TALLIES: [AfsmCounter; 7] = [
     AfsmCounter::PairsOwnTriangle,
     AfsmCounter::PairsOneSample,
 ];
-
-/// What a batch of view samples gives back.
-#[derive(Debug, Clone, PartialEq)]
-pub struct BatchOutput {
-    /// Per receiver: radiance sum of visible samples (xyz), visible count (w).
-    pub result: Vec<[f32; 4]>,
-    /// Per receiver: `W` words of visible bits.
-    pub visible: Vec<u32>,
-    /// List offsets (`side^2 + 1`, the last one the total).
-    pub offsets: Vec<u32>,
-    /// The influence regions of the last caster batch (kept for tests).
-    pub regions: Vec<Region>,
-    /// The occlusion tallies ([`TALLIES`]).
-    pub tallies: [u64; TALLIES.len()],
-    /// The tallies of work skipped, named.
-    pub skipped: Vec<(AfsmCounter, u64)>,
-}
-
-/// Runs every pass for one batch of receivers; `params` holds the frame, light and sizes
-/// (`dims[1]` is set here).
-///
-/// # Errors
-/// [`GpuError`] from any pass.
-pub fn run_batch(
-    gpu: &GpuContext,
-    pipes: &Pipelines,
-    mut params: Params,
-    receivers: &[Receiver],
-    shared: &Shared<'_>,
-    keep_regions: bool,
-    stats: &mut Stats,
-) -> Result<BatchOutput, GpuError> {
-    let n = receivers.len() as u32;
-    params.dims[1] = n;
-    params.options[0] = (!shared.silhouettes.is_empty()) as u32;
-    params.options[1] = shared.semi_opaque as u32;
-    params.options[3] = shared.culling as u32;
-    let side = params.dims[0];
-    let words = params.dims[3];
-    let texels = side * side;
-    let mut keep = Vec::new();
-    let tiles_per_side = side.div_ceil(8) as u64;
-    let (rbuf, counts, slots, lists, masks, result, tallies) =
-        timed(gpu, stats, AfsmPhase::GpuUpload, || {
-            Ok::<_, GpuError>((
-                gpu.storage("receivers", receivers)?,
-                gpu.storage_zeroed("list counts", (texels as u64 + 1) * 4)?,
-                gpu.storage_zeroed("slots", n as u64 * 8)?,
-                gpu.storage_zeroed("lists", n as u64 * 4)?,
-                gpu.storage_zeroed("masks", n as u64 * words as u64 * 4)?,
-                gpu.storage_zeroed("result", n as u64 * 16)?,
-                gpu.storage_zeroed("tallies", TALLY_WORDS as u64 * 4)?,
-            ))
-        })?;
-    let texel_depth = gpu.storage_zeroed("texel depths", texels as u64 * 4)?;
-    let tile_depth = gpu.storage_zeroed("tile depths", tiles_per_side * tiles_per_side * 4)?;
-    let tile_box = gpu.storage_zeroed("tile boxes", tiles_per_side * tiles_per_side * 24)?;
-    let texel_near = gpu.storage_zeroed("texel nearest depths", texels as u64 * 4)?;
-    let tile_near = gpu.storage_zeroed("tile nearest depths", tiles_per_side.pow(2) * 4)?;
-    // The box of the batch's ray origins, for the influence pass's root cull.
-    let (lo, hi) = receivers.iter().fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(lo, hi), r| (lo.min(r.origin()), hi.max(r.origin())),
-    );
-    let batch_box = gpu.storage(
-        "batch box",
-        &[[lo.x, lo.y, lo.z, 0.0], [hi.x, hi.y, hi.z, 0.0]],
-    )?;
-    let texel_bits = gpu.storage_zeroed("occupied texels per tile", tiles_per_side.pow(2) * 8)?;
-    let supers = tiles_per_side.div_ceil(4);
-    let super_bounds = gpu.storage_zeroed("super-tile bounds", supers * supers * 32)?;
-    // Per row of tiles, running counts of occupied tiles and their columns.
-    let occupancy = gpu.storage_zeroed(
-        "occupied tiles",
-        (tiles_per_side * (tiles_per_side + 1) + tiles_per_side.pow(2)) * 4,
-    )?;
-    let texel_hidden = gpu.storage_zeroed("hidden per texel", texels as u64 * 4)?;
-    let tile_count = gpu.storage_zeroed("view samples per tile", tiles_per_side.pow(2) * 4)?;
-    let tile_hidden = gpu.storage_zeroed("hidden per tile", tiles_per_side.pow(2) * 4)?;
-    let uni = gpu.uniform("params", &params);
-    let groups = (n as u64).div_ceil(64);
-    timed(gpu, stats, AfsmPhase::GpuLists, || {
-        let mut enc = gpu.encoder();
-        let b = gpu.bind(
-            &pipes.count,
-            &[
-                &uni,
-                &rbuf,
-                &counts,
-                &slots,
-                &texel_depth,
-                &tile_depth,
-                &tile_box,
-                &tile_count,
-                &texel_near,
-                &tile_near,
-                &super_bounds,
-                &texel_bits,
-            ],
-        );
-        gpu.dispatch(&mut enc, &pipes.count, &b, groups)?;
-        let b = gpu.bind(&pipes.occupancy, &[&uni, &tile_count, &occupancy]);
-        gpu.dispatch(&mut enc, &pipes.occupancy, &b, tiles_per_side.div_ceil(64))?;
-        scan(gpu, pipes, &mut enc, &counts, texels + 1, &mut keep)?;
-        gpu.submit(enc)?;
-        let mut enc = gpu.encoder();
-        let b = gpu.bind(&pipes.scatter, &[&uni, &slots, &counts, &lists]);
-        gpu.dispatch(&mut enc, &pipes.scatter, &b, groups)?;
-        gpu.submit(enc)
-    })?;
-    let largest = shared
-        .casters
-        .iter()
-        .chain(shared.silhouettes)
-        .map(|c| c.len)
-        .max()
-        .unwrap_or(0);
-    let regions = gpu.storage_zeroed(
-        "regions",
-        largest as u64 * std::mem::size_of::<Region>() as u64,
-    )?;
-    let flags = gpu.storage_zeroed("silhouette stencil", texels as u64 * 4)?;
-    let depth_slots = if shared.semi_opaque {
-        n as u64 * params.dims[2] as u64
-    } else {
-        1
-    };
-    let depths = gpu.storage_zeroed("optical depths", depth_slots * 4)?;
-    let occ = Occlusion {
-        gpu,
-        pipes,
-        shared,
-        regions: &regions,
-        receivers: &rbuf,
-        offsets: &counts,
-        lists: &lists,
-        masks: &masks,
-        tallies: &tallies,
-        flags: &flags,
-        depths: &depths,
-        tile_depth: &tile_depth,
-        texel_depth: &texel_depth,
-        tile_box: &tile_box,
-        texel_near: &texel_near,
-        tile_near: &tile_near,
-        occupancy: &occupancy,
-        super_bounds: &super_bounds,
-        texel_bits: &texel_bits,
-        batch_box: &batch_box,
-        slots: &slots,
-        texel_hidden: &texel_hidden,
-        tile_count: &tile_count,
-        tile_hidden: &tile_hidden,
-    };
-    for batch in shared.silhouettes {
-        occ.batch(params, batch, Work::Stencil, stats)?;
-    }
-    let mut last_regions = Vec::new();
-    for batch in shared.casters {
-        occ.batch(params, batch, Work::Occlude(batch), stats)?;
-        if keep_regions {
-            last_regions = gpu.read::<Region>(&regions, batch.len as usize)?;
-        }
-    }
-    timed(gpu, stats, AfsmPhase::GpuResolve, || {
-        let mut enc = gpu.encoder();
-        let b = gpu.bind(
-            &pipes.resolve,
-            &[
-                &uni,
-                &rbuf,
-                shared.samples,
-                shared.radiance,
-                &masks,
-                &result,
-                &depths,
-            ],
-        );
-        gpu.dispatch(&mut enc, &pipes.resolve, &b, groups)?;
-        gpu.submit(enc)
-    })?;
-    timed(gpu, stats, AfsmPhase::GpuReadback, || {
-        let t: Vec<u32> = gpu.read(&tallies, TALLY_WORDS)?;
-        let word = |k: usize| t[2 * k] as u64 | (t[2 * k + 1] as u64) << 32;
-        let mut tallies = [0u64; TALLIES.len()];
-        for (k, v) in tallies.iter_mut().enumerate() {
-            *v = word(k);
-        }
-        let skipped = SKIPPED_SLOTS
-            .iter()
-            .map(|&(k, name)| (name, word(k)))
-            .collect();
-        Ok(BatchOutput {
-            result: gpu.read(&result, n as usize)?,
-            visible: gpu.read(&masks, (n * words) as usize)?,
-            offsets: gpu.read(&counts, texels as usize + 1)?,
-            regions: last_regions,
-            tallies,
-            skipped,
-        })
-    })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The GPU scan against a CPU running sum, over sizes around the block boundaries and one
-    /// needing two levels of block totals.
-    #[test]
-    fn gpu_scan_equals_the_cpu_running_sum() {
-        let Some(gpu) = shadow_core::gpu::context_for_test("gpu_scan_equals_the_cpu_running_sum")
-        else {
-            return;
-        };
-        let pipes = Pipelines::new(&gpu).unwrap();
-        for n in [1u32, 511, 512, 513, 4097, 300_001] {
-            let data: Vec<u32> = (0..n)
-                .map(|i| i.wrapping_mul(2_654_435_761u32) >> 28)
-                .collect();
-            let buf = gpu.storage("data", &data).unwrap();
-            let mut keep = Vec::new();
-            let mut enc = gpu.encoder();
-            scan(&gpu, &pipes, &mut enc, &buf, n, &mut keep).unwrap();
-            gpu.submit(enc).unwrap();
-            let got: Vec<u32> = gpu.read(&buf, n as usize).unwrap();
-            let mut acc = 0u32;
-            for (i, v) in data.iter().enumerate() {
-                assert_eq!(got[i], acc, "n {n} at {i}");
-                acc += v;
-            }
-        }
-    }
-}

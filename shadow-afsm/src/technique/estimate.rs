@@ -10,10 +10,11 @@ use shadow_core::prelude::*;
 use shadow_core::visibility::{PerSampleVisibility, PixelClass};
 
 use super::{Afsm, PlaneTest, Prepared};
+use crate::batch::{BatchOutput, run_batch};
 use crate::frame::MapFrame;
 use crate::inputs::{casters_of, group_receivers, upload_casters};
 use crate::params::{Params, Receiver, Region};
-use crate::passes::{BatchOutput, CasterBatch, Shared, TALLIES, device_error, run_batch};
+use crate::passes::{CasterBatch, Shared, TALLIES, device_error};
 use crate::statistics::{AfsmCounter, AfsmGauge, AfsmPhase};
 
 /// The estimate, its receivers and each batch's frame, regions and list offsets (kept for
