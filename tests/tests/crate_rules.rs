@@ -449,3 +449,214 @@ fn no_source_file_is_over_800_lines() {
         .collect();
     assert!(long.is_empty(), "over {MAX_FILE_LINES} lines: {long:?}");
 }
+
+/// The most lines a function of the workspace may span, signature to closing brace
+/// (ARCHITECTURE.md: stage functions named for the stage).
+const MAX_FUNCTION_LINES: usize = 150;
+
+/// `text` with string and character literals and comments blanked out (newlines kept), so
+/// that braces and `fn` are read from code alone.
+fn code_only(text: &str) -> String {
+    #[derive(Clone, Copy, PartialEq)]
+    enum State {
+        Code,
+        Str,
+        RawStr(usize),
+        LineComment,
+        BlockComment(usize),
+    }
+    let chars: Vec<char> = text.chars().collect();
+    let mut out = String::with_capacity(text.len());
+    let mut state = State::Code;
+    let mut i = 0;
+    let blank = |c: char| if c == '\n' { '\n' } else { ' ' };
+    while i < chars.len() {
+        let c = chars[i];
+        let next = chars.get(i + 1).copied();
+        match state {
+            State::Code => {
+                if c == '/' && next == Some('/') {
+                    state = State::LineComment;
+                    out.push(' ');
+                } else if c == '/' && next == Some('*') {
+                    state = State::BlockComment(1);
+                    out.push_str("  ");
+                    i += 1;
+                } else if c == '"' {
+                    state = State::Str;
+                    out.push(' ');
+                } else if c == 'r'
+                    && (next == Some('"') || next == Some('#'))
+                    && !chars
+                        .get(i.wrapping_sub(1))
+                        .is_some_and(|p| p.is_alphanumeric() || *p == '_')
+                {
+                    let hashes = chars[i + 1..].iter().take_while(|&&h| h == '#').count();
+                    if chars.get(i + 1 + hashes) == Some(&'"') {
+                        state = State::RawStr(hashes);
+                        for _ in 0..hashes + 2 {
+                            out.push(' ');
+                        }
+                        i += hashes + 1;
+                    } else {
+                        out.push(c);
+                    }
+                } else if c == '\'' {
+                    // A character literal ('x', '\n', '\u{..}'), not a lifetime.
+                    let close = if next == Some('\\') {
+                        chars[i + 2..]
+                            .iter()
+                            .position(|&x| x == '\'')
+                            .map(|p| i + 2 + p)
+                    } else if chars.get(i + 2) == Some(&'\'') {
+                        Some(i + 2)
+                    } else {
+                        None
+                    };
+                    match close {
+                        Some(end) => {
+                            for _ in i..=end {
+                                out.push(' ');
+                            }
+                            i = end;
+                        }
+                        None => out.push(c),
+                    }
+                } else {
+                    out.push(c);
+                }
+            }
+            State::Str => {
+                if c == '\\' {
+                    out.push(' ');
+                    if let Some(n) = next {
+                        out.push(blank(n));
+                    }
+                    i += 1;
+                } else {
+                    if c == '"' {
+                        state = State::Code;
+                    }
+                    out.push(blank(c));
+                }
+            }
+            State::RawStr(hashes) => {
+                if c == '"' && chars[i + 1..].iter().take(hashes).all(|&h| h == '#') {
+                    state = State::Code;
+                    for _ in 0..=hashes {
+                        out.push(' ');
+                    }
+                    i += hashes;
+                } else {
+                    out.push(blank(c));
+                }
+            }
+            State::LineComment => {
+                if c == '\n' {
+                    state = State::Code;
+                }
+                out.push(blank(c));
+            }
+            State::BlockComment(depth) => {
+                if c == '*' && next == Some('/') {
+                    state = if depth == 1 {
+                        State::Code
+                    } else {
+                        State::BlockComment(depth - 1)
+                    };
+                    out.push_str("  ");
+                    i += 1;
+                } else if c == '/' && next == Some('*') {
+                    state = State::BlockComment(depth + 1);
+                    out.push_str("  ");
+                    i += 1;
+                } else {
+                    out.push(blank(c));
+                }
+            }
+        }
+        i += 1;
+    }
+    out
+}
+
+/// Each function with a body in `text`: its name, first line (1-based) and length in lines.
+fn functions(text: &str) -> Vec<(String, usize, usize)> {
+    let code = code_only(text);
+    let lines: Vec<&str> = code.lines().collect();
+    let mut out = Vec::new();
+    for (start, line) in lines.iter().enumerate() {
+        let mut words = line.split_whitespace().peekable();
+        while let Some(w) = words.peek() {
+            if w.starts_with("pub") || ["const", "async", "unsafe", "extern"].contains(w) {
+                words.next();
+            } else {
+                break;
+            }
+        }
+        if words.next() != Some("fn") {
+            continue;
+        }
+        let name: String = words
+            .next()
+            .unwrap_or("")
+            .chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect();
+        let (mut depth, mut opened) = (0i64, false);
+        'body: for (k, l) in lines.iter().enumerate().skip(start) {
+            for c in l.chars() {
+                match c {
+                    '{' => {
+                        depth += 1;
+                        opened = true;
+                    }
+                    '}' => depth -= 1,
+                    ';' if !opened => break 'body,
+                    _ => {}
+                }
+                if opened && depth == 0 {
+                    out.push((name.clone(), start + 1, k - start + 1));
+                    break 'body;
+                }
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn the_function_reader_measures_bodies_and_skips_literals_and_comments() {
+    let text = "fn a() {\n    let s = \"}}}\";\n    // }\n    let c = '{';\n}\n\
+                pub(crate) fn b(x: &'static str) -> u8 {\n    let r = r#\"{\"#;\n    1\n}\n\
+                fn declared();\n";
+    let f = functions(text);
+    assert_eq!(
+        f,
+        vec![("a".to_string(), 1, 5), ("b".to_string(), 6, 4)],
+        "{}",
+        code_only(text)
+    );
+}
+
+#[test]
+fn no_function_is_over_150_lines() {
+    let mut files = Vec::new();
+    rust_files(&root(), &mut files);
+    let mut measured = 0;
+    let mut long = Vec::new();
+    for f in &files {
+        let text = std::fs::read_to_string(f).expect("readable source");
+        for (name, line, n) in functions(&text) {
+            measured += 1;
+            if n > MAX_FUNCTION_LINES {
+                long.push(format!("{}:{line} {name} ({n} lines)", f.display()));
+            }
+        }
+    }
+    assert!(measured > 1000, "measured {measured} functions");
+    assert!(
+        long.is_empty(),
+        "over {MAX_FUNCTION_LINES} lines: {long:#?}"
+    );
+}

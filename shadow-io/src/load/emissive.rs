@@ -37,7 +37,8 @@ enum Shape {
     Sphere(SphereLight),
 }
 
-/// Builds the light an emissive mesh describes (positions in world space).
+/// Builds the light an emissive mesh describes (positions in world space): a rectangle,
+/// disk or polygon for one flat outline, a sphere for a closed round mesh, else a mesh light.
 ///
 /// # Errors
 /// [`LoadError::Unsupported`] for a mesh without area and a texture without texture
@@ -58,136 +59,34 @@ pub fn light_from_emissive_mesh(
         return Err(unsupported("emissive mesh has no triangles"));
     }
     let constant = Radiance::constant(emission).map_err(light_err)?;
-    // Weld exactly equal positions.
-    let mut ids: HashMap<[u32; 3], u32> = HashMap::new();
-    let mut welded: Vec<Vec3> = Vec::new();
-    let remap: Vec<u32> = positions
-        .iter()
-        .map(|p| {
-            let next = welded.len() as u32;
-            *ids.entry(p.to_array().map(f32::to_bits))
-                .or_insert_with(|| {
-                    welded.push(*p);
-                    next
-                })
-        })
-        .collect();
-    let tris: Vec<[u32; 3]> = triangles
-        .iter()
-        .map(|t| t.map(|v| remap[v as usize]))
-        .collect();
-    let diag = Aabb::from_points(&welded).diagonal() as f64;
-    let mut n = DVec3::ZERO;
-    let mut abs_area = 0.0;
-    for t in &tris {
-        let c = triangle_cross_f64(
-            welded[t[0] as usize],
-            welded[t[1] as usize],
-            welded[t[2] as usize],
-        );
-        n += c;
-        abs_area += c.length();
-    }
-    let centroid = welded.iter().fold(DVec3::ZERO, |a, p| a + p.as_dvec3()) / welded.len() as f64;
-    let boundary = boundary_loops(&tris);
-    let planar = n.length() > 0.999 * abs_area && {
-        let nn = n.normalize();
-        welded
-            .iter()
-            .all(|p| (p.as_dvec3() - centroid).dot(nn).abs() <= 1e-4 * diag)
-    };
-    if !(abs_area > 0.0) {
+    let w = Welded::new(positions, triangles);
+    if !(w.abs_area > 0.0) {
         return Err(unsupported(
             "emissive mesh has no area: every triangle is degenerate",
         ));
     }
     let as_mesh = |texture| mesh_light(name, positions, triangles, emission, texture);
-    let shape = if planar {
-        let normal = n.normalize().as_vec3();
-        let outline = match boundary {
-            Ok(loops) if loops.len() == 1 => simplify(
-                &loops[0]
-                    .iter()
-                    .map(|&v| welded[v as usize])
-                    .collect::<Vec<_>>(),
-            ),
-            // Holes, several pieces, a boundary touching itself: any shape is a mesh light.
-            _ => return as_mesh(texture),
-        };
-        match planar_shape(&outline, normal, constant.clone()) {
-            Ok(shape) => shape,
-            Err(LightError::InvalidPolygon(_)) => return as_mesh(texture),
-            Err(e) => return Err(light_err(e)),
-        }
+    let shape = if w.planar() {
+        planar_outline_shape(&w, constant.clone()).map_err(light_err)?
+    } else if texture.is_none() {
+        w.sphere(constant.clone()).map_err(light_err)?
     } else {
-        let closed = matches!(&boundary, Ok(l) if l.is_empty());
-        let dists: Vec<f64> = welded
-            .iter()
-            .map(|p| (p.as_dvec3() - centroid).length())
-            .collect();
-        let r = dists.iter().sum::<f64>() / dists.len() as f64;
-        // A plane through the largest triangle, to tell a flat mesh whose faces cancel
-        // (double-sided, or wound both ways) from one that is not flat at all.
-        let largest = tris.iter().max_by(|a, b| {
-            let area = |t: &&[u32; 3]| {
-                triangle_cross_f64(
-                    welded[t[0] as usize],
-                    welded[t[1] as usize],
-                    welded[t[2] as usize],
-                )
-                .length()
-            };
-            area(a).total_cmp(&area(b))
-        });
-        let flat_both_ways = largest.is_some_and(|t| {
-            let c = triangle_cross_f64(
-                welded[t[0] as usize],
-                welded[t[1] as usize],
-                welded[t[2] as usize],
-            );
-            c.length() > 0.0 && {
-                let nn = c.normalize();
-                let o = welded[t[0] as usize].as_dvec3();
-                welded
-                    .iter()
-                    .all(|p| (p.as_dvec3() - o).dot(nn).abs() <= 1e-4 * diag)
-            }
-        });
-        if !flat_both_ways
-            && texture.is_none()
-            && closed
-            && welded.len() >= 6
-            && dists.iter().all(|d| (d - r).abs() <= 2e-3 * r)
-        {
-            Shape::Sphere(
-                SphereLight::new(centroid.as_vec3(), r as f32, constant.clone())
-                    .map_err(light_err)?,
-            )
-        } else {
-            // Bent, or flat with triangles facing both ways (a double-sided card emits from
-            // both sides, each triangle from its front).
-            return as_mesh(texture);
-        }
+        None
+    };
+    // Holes, several pieces, a bent mesh, or one flat with triangles facing both ways (a
+    // double-sided card emits from both sides, each triangle from its front): a mesh light.
+    let Some(shape) = shape else {
+        return as_mesh(texture);
     };
     let radiance = match texture {
         None => constant,
         Some(tex) => {
-            let uv_of = |p: Vec3| -> Result<Vec2, LoadError> {
-                match &shape {
-                    Shape::Rect(l) => Ok(l.uv_of(p)),
-                    Shape::Disk(l) => Ok(l.uv_of(p)),
-                    Shape::Polygon(l) => Ok(l.uv_of(p)),
-                    Shape::Sphere(_) => unreachable!("textured emitters are never spheres"),
-                }
-            };
             if tex.texcoords.len() != positions.len() {
                 return Err(unsupported("emissive texture without texture coordinates"));
             }
-            let light_uv = positions
-                .iter()
-                .map(|p| uv_of(*p))
-                .collect::<Result<Vec<_>, _>>()?;
-            let Some(map) = fit_affine(triangles, &light_uv, &tex.texcoords) else {
+            let light_uv: Option<Vec<Vec2>> = positions.iter().map(|p| shape.uv_of(*p)).collect();
+            let map = light_uv.and_then(|uv| fit_affine(triangles, &uv, &tex.texcoords));
+            let Some(map) = map else {
                 // Not one affine map over the exact shape: each triangle keeps its own.
                 return as_mesh(Some(tex));
             };
@@ -204,6 +103,149 @@ pub fn light_from_emissive_mesh(
         Shape::Sphere(l) => Arc::new(l),
     };
     Ok(light)
+}
+
+impl Shape {
+    /// Where `p` lies in the light's own texture coordinates; `None` on a sphere, which has
+    /// none.
+    fn uv_of(&self, p: Vec3) -> Option<Vec2> {
+        match self {
+            Shape::Rect(l) => Some(l.uv_of(p)),
+            Shape::Disk(l) => Some(l.uv_of(p)),
+            Shape::Polygon(l) => Some(l.uv_of(p)),
+            Shape::Sphere(_) => None,
+        }
+    }
+}
+
+/// The mesh with exactly equal positions welded, and the sums its shape is read from.
+struct Welded {
+    positions: Vec<Vec3>,
+    tris: Vec<[u32; 3]>,
+    diag: f64,
+    /// The sum of the triangles' area vectors.
+    normal_sum: DVec3,
+    /// The sum of their areas (twice).
+    abs_area: f64,
+    centroid: DVec3,
+}
+
+impl Welded {
+    fn new(positions: &[Vec3], triangles: &[[u32; 3]]) -> Self {
+        let mut ids: HashMap<[u32; 3], u32> = HashMap::new();
+        let mut welded: Vec<Vec3> = Vec::new();
+        let remap: Vec<u32> = positions
+            .iter()
+            .map(|p| {
+                let next = welded.len() as u32;
+                *ids.entry(p.to_array().map(f32::to_bits))
+                    .or_insert_with(|| {
+                        welded.push(*p);
+                        next
+                    })
+            })
+            .collect();
+        let tris: Vec<[u32; 3]> = triangles
+            .iter()
+            .map(|t| t.map(|v| remap[v as usize]))
+            .collect();
+        let diag = Aabb::from_points(&welded).diagonal() as f64;
+        let mut normal_sum = DVec3::ZERO;
+        let mut abs_area = 0.0;
+        for t in &tris {
+            let c = triangle_cross_f64(
+                welded[t[0] as usize],
+                welded[t[1] as usize],
+                welded[t[2] as usize],
+            );
+            normal_sum += c;
+            abs_area += c.length();
+        }
+        let centroid =
+            welded.iter().fold(DVec3::ZERO, |a, p| a + p.as_dvec3()) / welded.len() as f64;
+        Self {
+            positions: welded,
+            tris,
+            diag,
+            normal_sum,
+            abs_area,
+            centroid,
+        }
+    }
+
+    fn cross(&self, t: &[u32; 3]) -> DVec3 {
+        triangle_cross_f64(
+            self.positions[t[0] as usize],
+            self.positions[t[1] as usize],
+            self.positions[t[2] as usize],
+        )
+    }
+
+    /// Every triangle faces one way and every vertex lies in one plane.
+    fn planar(&self) -> bool {
+        self.normal_sum.length() > 0.999 * self.abs_area && {
+            let nn = self.normal_sum.normalize();
+            self.positions
+                .iter()
+                .all(|p| (p.as_dvec3() - self.centroid).dot(nn).abs() <= 1e-4 * self.diag)
+        }
+    }
+
+    /// A sphere light for a closed mesh whose vertices all lie at one distance from their
+    /// centroid; `None` for any other shape. A flat mesh whose faces cancel (double-sided, or
+    /// wound both ways) is told from a round one by a plane through its largest triangle.
+    fn sphere(&self, constant: Radiance) -> Result<Option<Shape>, LightError> {
+        let closed = matches!(boundary_loops(&self.tris), Ok(l) if l.is_empty());
+        let dists: Vec<f64> = self
+            .positions
+            .iter()
+            .map(|p| (p.as_dvec3() - self.centroid).length())
+            .collect();
+        let r = dists.iter().sum::<f64>() / dists.len() as f64;
+        let largest = self
+            .tris
+            .iter()
+            .max_by(|a, b| self.cross(a).length().total_cmp(&self.cross(b).length()));
+        let flat_both_ways = largest.is_some_and(|t| {
+            let c = self.cross(t);
+            c.length() > 0.0 && {
+                let nn = c.normalize();
+                let o = self.positions[t[0] as usize].as_dvec3();
+                self.positions
+                    .iter()
+                    .all(|p| (p.as_dvec3() - o).dot(nn).abs() <= 1e-4 * self.diag)
+            }
+        });
+        if !flat_both_ways
+            && closed
+            && self.positions.len() >= 6
+            && dists.iter().all(|d| (d - r).abs() <= 2e-3 * r)
+        {
+            let sphere = SphereLight::new(self.centroid.as_vec3(), r as f32, constant)?;
+            return Ok(Some(Shape::Sphere(sphere)));
+        }
+        Ok(None)
+    }
+}
+
+/// The rectangle, disk or polygon a flat mesh's one boundary loop outlines; `None` for holes,
+/// several pieces, a boundary touching itself or an outline no polygon light takes.
+fn planar_outline_shape(w: &Welded, constant: Radiance) -> Result<Option<Shape>, LightError> {
+    let normal = w.normal_sum.normalize().as_vec3();
+    let outline = match boundary_loops(&w.tris) {
+        Ok(loops) if loops.len() == 1 => simplify(
+            &loops[0]
+                .iter()
+                .map(|&v| w.positions[v as usize])
+                .collect::<Vec<_>>(),
+        ),
+        _ => return Ok(None),
+    };
+    match planar_shape(&outline, normal, constant) {
+        Ok(shape) => Ok(Some(shape)),
+        Err(LightError::InvalidPolygon(_)) => Ok(None),
+        Err(e) => Err(e),
+    }
 }
 
 /// The emissive mesh as a [`MeshLight`]: every triangle of area, in its winding, with its
