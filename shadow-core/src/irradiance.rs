@@ -27,6 +27,7 @@
 
 use glam::{DVec2, DVec3, Vec3};
 
+use crate::clip::{Keep, clip_by_side};
 use crate::light::{AreaLight, LightGeometry, LightSample, Radiance};
 use crate::view_samples::ViewSample;
 
@@ -150,17 +151,7 @@ pub fn pixel_ratio_direct(
 /// Keeps the part of the polygon `pts` (relative to the origin) with `x . n > 0`.
 fn clip(pts: &[DVec3], n: DVec3) -> Vec<DVec3> {
     let mut out = Vec::with_capacity(pts.len() + 2);
-    for (i, &a) in pts.iter().enumerate() {
-        let b = pts[(i + 1) % pts.len()];
-        let (da, db) = (a.dot(n), b.dot(n));
-        if da > 0.0 {
-            out.push(a);
-        }
-        if (da > 0.0) != (db > 0.0) {
-            let t = da / (da - db);
-            out.push(a + (b - a) * t);
-        }
-    }
+    clip_by_side(pts, &mut out, |x| x.dot(n), Keep::Positive);
     out
 }
 

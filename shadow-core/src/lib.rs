@@ -59,6 +59,7 @@
 
 pub mod albedo;
 pub mod camera;
+pub mod clip;
 pub mod direct;
 pub mod geometry;
 #[cfg(feature = "gpu")]

@@ -20,6 +20,7 @@
 //!   `(1/A) ∫ L(x) vis(x) dx`, DCS eq. 2's limit for many samples.
 
 use glam::{DAffine2, DVec2, DVec3, Vec2};
+use shadow_core::clip::{Keep, clip_by_side};
 use shadow_core::light::{AreaLight, LightGeometry};
 
 /// Cells per side of a radiance table.
@@ -378,18 +379,7 @@ impl LightDomain {
 /// Clips `poly` to the half-plane `n . x >= c` (Sutherland-Hodgman; a concave subject gives
 /// extra zero-area edges, never a wrong area).
 fn clip(poly: &mut Vec<DVec2>, scratch: &mut Vec<DVec2>, n: DVec2, c: f64) {
-    scratch.clear();
-    let m = poly.len();
-    for i in 0..m {
-        let (a, b) = (poly[i], poly[(i + 1) % m]);
-        let (sa, sb) = (n.dot(a) - c, n.dot(b) - c);
-        if sa >= 0.0 {
-            scratch.push(a);
-        }
-        if (sa >= 0.0) != (sb >= 0.0) {
-            scratch.push(a + (b - a) * (sa / (sa - sb)));
-        }
-    }
+    clip_by_side(poly, scratch, |x| n.dot(x) - c, Keep::NonNegative);
     std::mem::swap(poly, scratch);
 }
 

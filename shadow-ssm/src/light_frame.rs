@@ -3,6 +3,7 @@
 //! width, plus the exact fraction of the light above a receiver's tangent plane.
 
 use glam::{DVec3, Vec3};
+use shadow_core::clip::{Keep, clip_by_side};
 use shadow_core::light::AreaLight;
 use shadow_core::technique::{TechniqueError, UnsupportedReason};
 
@@ -105,18 +106,8 @@ impl LightFrame {
         if above == pts.len() {
             return 1.0;
         }
-        // Sutherland-Hodgman against the half-space side > 0.
         let mut clipped = Vec::with_capacity(pts.len() + 2);
-        for i in 0..pts.len() {
-            let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
-            let (sa, sb) = (side(a), side(b));
-            if sa > 0.0 {
-                clipped.push(a);
-            }
-            if (sa > 0.0) != (sb > 0.0) {
-                clipped.push(a + (b - a) * (sa / (sa - sb)));
-            }
-        }
+        clip_by_side(&pts, &mut clipped, side, Keep::Positive);
         if clipped.len() < 3 {
             return 0.0;
         }

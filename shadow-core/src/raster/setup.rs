@@ -279,19 +279,19 @@ fn clip_and_project(v: &[Vec3], view: &RasterView) -> Vec<(DVec2, f64)> {
     let pts: Vec<glam::DVec3> = v.iter().map(|p| p.as_dvec3()).collect();
     let near = near as f64;
     let mut poly: Vec<glam::DVec3> = Vec::with_capacity(pts.len() + 1);
-    for i in 0..pts.len() {
-        let (a, c) = (pts[i], pts[(i + 1) % pts.len()]);
-        let (da, dc) = (-a.z - near, -c.z - near);
-        if da >= 0.0 {
-            poly.push(a);
-        }
-        if (da >= 0.0) != (dc >= 0.0) {
+    let depth = |a: glam::DVec3| -a.z - near;
+    crate::clip::clip_polygon(
+        &pts,
+        &mut poly,
+        |a| depth(a) >= 0.0,
+        |a, c| {
+            let (da, dc) = (depth(a), depth(c));
             let s = da / (da - dc);
             let mut q = a + (c - a) * s;
             q.z = -near; // exactly on the plane
-            poly.push(q);
-        }
-    }
+            q
+        },
+    );
     if poly.len() < 3 {
         return Vec::new();
     }

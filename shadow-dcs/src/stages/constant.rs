@@ -21,6 +21,7 @@
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
+use shadow_core::clip::clip_polygon;
 use shadow_core::raster::{CoveredPolygon, Projection, RasterView};
 use shadow_core::scene::Scene;
 
@@ -239,25 +240,18 @@ fn clip_to_box(poly: &[DVec3], lo: DVec3, hi: DVec3) -> Vec<DVec3> {
                     v[axis] >= bound
                 }
             };
-            next.clear();
-            let n = cur.len();
-            for i in 0..n {
-                let (a, b) = (cur[i], cur[(i + 1) % n]);
-                if inside(a) {
-                    next.push(a);
-                }
-                if inside(a) != inside(b) {
-                    let (p, q) = if a.to_array() < b.to_array() {
-                        (a, b)
-                    } else {
-                        (b, a)
-                    };
-                    let t = (bound - p[axis]) / (q[axis] - p[axis]);
-                    let mut x = p + (q - p) * t;
-                    x[axis] = bound;
-                    next.push(x);
-                }
-            }
+            let crossing = |a: DVec3, b: DVec3| {
+                let (p, q) = if a.to_array() < b.to_array() {
+                    (a, b)
+                } else {
+                    (b, a)
+                };
+                let t = (bound - p[axis]) / (q[axis] - p[axis]);
+                let mut x = p + (q - p) * t;
+                x[axis] = bound;
+                x
+            };
+            clip_polygon(&cur, &mut next, inside, crossing);
             std::mem::swap(&mut cur, &mut next);
         }
     }
