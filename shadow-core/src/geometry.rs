@@ -163,26 +163,31 @@ pub fn convex_hull(mut p: Vec<DVec2>) -> Vec<DVec2> {
 /// What the parity tests of closed meshes take (DCS's one-sided meshes, AFSM's eye inside a
 /// closed mesh).
 pub fn ray_hits_triangle(o: DVec3, d: DVec3, a: DVec3, b: DVec3, c: DVec3, t_max: f64) -> bool {
+    ray_triangle_t(o, d, a, b, c, t_max).is_some()
+}
+
+/// [`ray_hits_triangle`]'s hit parameter `t`, when it hits.
+pub fn ray_triangle_t(o: DVec3, d: DVec3, a: DVec3, b: DVec3, c: DVec3, t_max: f64) -> Option<f64> {
     let e1 = b - a;
     let e2 = c - a;
     let pv = d.cross(e2);
     let det = e1.dot(pv);
     if det == 0.0 {
-        return false;
+        return None;
     }
     let inv = 1.0 / det;
     let tv = o - a;
     let u = tv.dot(pv) * inv;
     if !(0.0..=1.0).contains(&u) {
-        return false;
+        return None;
     }
     let qv = tv.cross(e1);
     let v = d.dot(qv) * inv;
     if v < 0.0 || u + v > 1.0 {
-        return false;
+        return None;
     }
     let t = e2.dot(qv) * inv;
-    t > 0.0 && t < t_max
+    (t > 0.0 && t < t_max).then_some(t)
 }
 
 #[cfg(test)]

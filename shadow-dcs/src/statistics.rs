@@ -11,6 +11,8 @@ shadow_core::statistics! {
         ShadowVolumesSkipped => "shadow-volumes-skipped",
         /// Shadow-volume quads rasterized for the integration constants.
         ShadowVolumeQuads => "shadow-volume-quads",
+        /// Receivers without a camera whose integration constant was counted along their own segment to the light centre.
+        ReceiverConstantSegments => "receiver-constant-segments",
         /// Edges of the scene's meshes.
         Edges => "edges",
         /// Edges on the silhouette seen from the light.
@@ -95,6 +97,8 @@ shadow_core::statistics! {
         SquarePlan => "square-plan",
         /// The integration constants from shadow volumes.
         ShadowVolumes => "shadow-volumes",
+        /// The integration constants of receivers without a camera, one segment each.
+        ReceiverConstants => "receiver-constants",
         /// Gathering the scene's edges.
         Edges => "edges",
         /// Finding the silhouette edges.

@@ -48,9 +48,7 @@ const SV_BAND: u32 = 8;
 pub(crate) fn eye_constant(scene: &dyn Scene, edges_units: u32, eye: Vec3, c: Vec3) -> i64 {
     let (o, target) = (eye.as_dvec3(), c.as_dvec3());
     let d = target - o;
-    let topo = scene.topology();
-    let opac = scene.opacities();
-    let semi = scene.has_semi_opaque();
+    let rule = CrossingRule::new(scene, edges_units, target);
     (0..scene.triangle_count())
         .into_par_iter()
         .map(|t| {
@@ -58,18 +56,48 @@ pub(crate) fn eye_constant(scene: &dyn Scene, edges_units: u32, eye: Vec3, c: Ve
             if !ray_hits_triangle(o, d, a, b, cc, 1.0) {
                 return 0;
             }
-            let comp = &topo.components()[topo.component_of(t)];
-            let one_sided = comp.closed && comp.consistently_oriented;
-            let front_from_light = (b - a).cross(cc - a).dot(target - a) > 0.0;
-            if one_sided && !front_from_light {
-                0
-            } else if semi {
-                (opac[t].clamp(0.0, 1.0) * edges_units as f32).ceil() as i64
-            } else {
-                1
-            }
+            rule.weight(t)
         })
         .sum()
+}
+
+/// What a segment toward the light centre adds to a depth complexity where it crosses a
+/// triangle (section 4.1 with section 6's opacities).
+pub(crate) struct CrossingRule<'s> {
+    scene: &'s dyn Scene,
+    units: u32,
+    target: DVec3,
+    semi: bool,
+}
+
+impl<'s> CrossingRule<'s> {
+    /// The rule for segments toward `target` in `scene`, opacities in `units` per face.
+    pub(crate) fn new(scene: &'s dyn Scene, units: u32, target: DVec3) -> Self {
+        Self {
+            scene,
+            units,
+            target,
+            semi: scene.has_semi_opaque(),
+        }
+    }
+
+    /// The weight of triangle `t`: 0 for the back (from the light) of a one-sided (closed,
+    /// consistently oriented) mesh, else 1, or its opacity in units when the scene is
+    /// semi-opaque.
+    pub(crate) fn weight(&self, t: usize) -> i64 {
+        let [a, b, cc] = self.scene.triangle(t).map(|v| v.as_dvec3());
+        let topo = self.scene.topology();
+        let comp = &topo.components()[topo.component_of(t)];
+        let one_sided = comp.closed && comp.consistently_oriented;
+        let front_from_light = (b - a).cross(cc - a).dot(self.target - a) > 0.0;
+        if one_sided && !front_from_light {
+            0
+        } else if self.semi {
+            (self.scene.opacities()[t].clamp(0.0, 1.0) * self.units as f32).ceil() as i64
+        } else {
+            1
+        }
+    }
 }
 
 /// The integration constant of every pixel (0 for background), by rasterizing the

@@ -9,4 +9,5 @@ pub(crate) mod coverage;
 pub mod discrete;
 pub mod edges;
 pub(crate) mod light_shape;
+pub(crate) mod receiver_constant;
 pub(crate) mod wedges;

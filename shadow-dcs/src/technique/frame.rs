@@ -11,7 +11,9 @@ use crate::statistics::{DcsCounter, DcsGauge, DcsPhase};
 impl Dcs {
     /// Everything per frame before the per-pixel pass: the view samples' origins and horizons,
     /// the squares with their wedges and where each square's visibility comes from (the plan),
-    /// and the integration constants of the pixels DCS estimates.
+    /// and the integration constants of the pixels DCS estimates: from the eye's shadow
+    /// volumes under a perspective camera, else per receiver along its own segment to the
+    /// light centre ([`crate::stages::receiver_constant`]).
     pub(super) fn frame<'a, 'p>(
         &self,
         p: &'p Prepared,
@@ -19,16 +21,6 @@ impl Dcs {
         traceable: bool,
         stats: &mut Stats,
     ) -> Result<(Frame<'a>, Plan<'p>), TechniqueError> {
-        let (eye, camera) = view.perspective().ok_or_else(|| {
-            TechniqueError::unsupported(
-                &self.name,
-                UnsupportedReason::View(
-                    "orthographic views and receivers without a camera: the shadow-volume step \
-                     counts quads from an eye point"
-                        .into(),
-                ),
-            )
-        })?;
         let n = view.len();
         let (origins, horizon): (Vec<Vec3>, Vec<Horizon>) = (0..n)
             .into_par_iter()
@@ -67,19 +59,19 @@ impl Dcs {
             view,
         };
         let plan = stats.time(DcsPhase::SquarePlan, || self.plan(p, &f, traceable));
-        self.integration_constants(p, &mut f, &plan, (eye, camera), stats);
+        self.integration_constants(p, &mut f, &plan, view.perspective(), stats);
         Ok((f, plan))
     }
 
     /// The integration constant `D(p, c)` of every view sample (section 4.1: the shadow-volume
-    /// step; none when `plan` traces the frame) and the counter width from the largest
-    /// (section 5.3).
+    /// step from the eye of a perspective `camera`, else each receiver's own crossings; none
+    /// when `plan` traces the frame) and the counter width from the largest (section 5.3).
     fn integration_constants(
         &self,
         p: &Prepared,
         f: &mut Frame,
         plan: &Plan,
-        (eye, camera): (Vec3, &shadow_core::raster::RasterView),
+        camera: Option<(Vec3, &shadow_core::raster::RasterView)>,
         stats: &mut Stats,
     ) {
         let c = p.shape.center;
@@ -91,21 +83,34 @@ impl Dcs {
             return;
         }
         let (origins, centred) = (&f.origins, &f.centred);
-        let (constants, quads) = stats.time(DcsPhase::ShadowVolumes, || {
-            let eye_c = eye_constant(p.scene.as_ref(), p.units, eye, c);
-            integration_constants(
-                &p.edges,
-                &p.silhouettes,
-                c,
-                eye,
-                eye_c,
-                camera,
-                origins,
-                centred,
-                &f.active,
-            )
-        });
-        stats.add(DcsCounter::ShadowVolumeQuads, quads);
+        let constants = match camera {
+            Some((eye, camera)) => {
+                let (constants, quads) = stats.time(DcsPhase::ShadowVolumes, || {
+                    let eye_c = eye_constant(p.scene.as_ref(), p.units, eye, c);
+                    integration_constants(
+                        &p.edges,
+                        &p.silhouettes,
+                        c,
+                        eye,
+                        eye_c,
+                        camera,
+                        origins,
+                        centred,
+                        &f.active,
+                    )
+                });
+                stats.add(DcsCounter::ShadowVolumeQuads, quads);
+                constants
+            }
+            None => {
+                let constants = stats.time(DcsPhase::ReceiverConstants, || {
+                    receiver_constants(p.scene.as_ref(), p.units, c, origins, &f.active)
+                });
+                let counted = f.active.iter().filter(|a| **a).count();
+                stats.add(DcsCounter::ReceiverConstantSegments, counted as u64);
+                constants
+            }
+        };
         let max_constant = constants.par_iter().copied().max().unwrap_or(0).max(0) as u64;
         f.bits = self.forced_bits.unwrap_or_else(|| width_for(max_constant));
         f.constants = constants;

@@ -62,6 +62,7 @@ use crate::stages::coverage::{EdgeTest, RelativePolygon, RelativeSamples};
 use crate::stages::discrete::{CoveredSamples, DiscreteTables, LineMasks};
 use crate::stages::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
 use crate::stages::light_shape::LightShape;
+use crate::stages::receiver_constant::receiver_constants;
 use crate::stages::wedges::{FOLD_SLACK, Pair};
 
 mod frame;
@@ -597,8 +598,8 @@ impl ShadowTechnique for Dcs {
             sample_based: true,
             processor: Processor::Cpu,
             // The integration constant is counted over shadow-volume quads from the eye
-            // (section 4.1).
-            needs_camera: true,
+            // (section 4.1), or per receiver along its segment to the light centre.
+            needs_camera: false,
         }
     }
 
