@@ -188,7 +188,6 @@ impl ShadowTechnique for Auto {
             light,
             probe,
             reference: OnceLock::new(),
-            camera_free_probe: OnceLock::new(),
             probe_prepare,
             usable,
             chosen: Mutex::new(Vec::new()),
@@ -206,9 +205,6 @@ pub struct PreparedAuto {
     /// The reference family's BVH after a DCS probe, built when a reference configuration is
     /// first chosen.
     reference: OnceLock<PreparedAdaptive>,
-    /// The reference's probe, for receivers the DCS probe cannot look at (no camera), built
-    /// when first needed.
-    camera_free_probe: OnceLock<(Probe, f64)>,
     probe_prepare: f64,
     usable: Vec<(Candidate, Box<dyn ShadowTechnique>)>,
     /// Configurations already prepared by an earlier estimate, by name: a renderer that calls
@@ -307,31 +303,6 @@ impl PreparedAuto {
             list.push((name, prepared.clone()));
         }
         Ok(prepared)
-    }
-
-    /// The probe that looks at `view` and its preparation time: the prepared one, or for
-    /// receivers without a camera after a DCS probe (DCS counts from the eye) the reference's,
-    /// built once.
-    ///
-    /// # Errors
-    /// The reference probe's preparation error.
-    fn probe_for(&self, view: &ViewSamples) -> Result<(&Probe, f64), TechniqueError> {
-        if view.eye().is_some() || self.probe.kind() != ProbeKind::Dcs {
-            return Ok((&self.probe, self.probe_prepare));
-        }
-        if let Some((p, t)) = self.camera_free_probe.get() {
-            return Ok((p, *t));
-        }
-        let t0 = Instant::now();
-        let probe = Probe::prepare_kind(
-            ProbeKind::Reference,
-            self.scene.clone(),
-            self.light.clone(),
-            self.config.seed,
-        )?;
-        let built = (probe, t0.elapsed().as_secs_f64());
-        let (p, t) = self.camera_free_probe.get_or_init(|| built);
-        Ok((p, *t))
     }
 
     /// The prepared reference whose BVH the reference family shares: the probe's, else one
@@ -504,7 +475,7 @@ impl PreparedShadows for PreparedAuto {
     /// ([`PreparedAuto::estimate`] is this pass).
     fn pass(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError> {
         let t0 = Instant::now();
-        let (probe, probe_prepare) = self.probe_for(view)?;
+        let (probe, probe_prepare) = (&self.probe, self.probe_prepare);
         let features = probe_features(
             probe,
             self.scene.as_ref(),
