@@ -46,33 +46,6 @@ const AUTO_01: &[(&str, [f64; 5])] = &[
     ("interior", [0.0054, 0.0181, 0.0001, 0.071, 0.0000]),
     ("interior-window", [0.0047, 0.0087, 0.0001, 0.034, 0.0000]),
     ("corpus", [0.0088, 0.0557, 0.0002, 0.188, 0.0017]),
-    // Receivers without a camera, where DCS is no candidate (`cargo test -p shadow-tests
-    // --test conformance -- points/auto`).
-    ("bunny@points", [0.0090, 0.0250, 0.0001, 0.099, 0.0000]),
-    ("interior@points", [0.0096, 0.0323, 0.0002, 0.119, 0.0003]),
-    // The same on every built-in scene where the pick without DCS errs above the camera row
-    // (`cargo xtask conformance --receivers points --quick`).
-    (
-        "overlapping-occluders@points",
-        [0.0107, 0.0170, 0.0000, 0.071, 0.0000],
-    ),
-    (
-        "large-light-close@points",
-        [0.0109, 0.0122, 0.0001, 0.059, 0.0000],
-    ),
-    (
-        "sphere-light@points",
-        [0.0104, 0.0257, 0.0000, 0.105, 0.0001],
-    ),
-    (
-        "cornell-box@points",
-        [0.0109, 0.0175, 0.0001, 0.079, 0.0000],
-    ),
-    ("spot-lamp@points", [0.0084, 0.0292, 0.0001, 0.120, 0.0002]),
-    (
-        "interior-window@points",
-        [0.0110, 0.0206, -0.0001, 0.099, 0.0000],
-    ),
     // `interior`'s light 1, the disk pendant, shadowed with the scene's other lights: a small
     // light where the chooser's cheaper pick lands near its target (`cargo xtask conformance
     // --scenes interior --quick`).
@@ -99,8 +72,6 @@ const AUTO_003: &[(&str, [f64; 5])] = &[
     ("interior", [0.0021, 0.0072, -0.0000, 0.026, 0.0000]),
     ("interior-window", [0.0032, 0.0059, -0.0000, 0.116, 0.0001]),
     ("corpus", [0.0031, 0.0201, 0.0001, 0.068, 0.0000]),
-    ("bunny@points", [0.0026, 0.0072, -0.0000, 0.037, 0.0000]),
-    ("interior@points", [0.0026, 0.0088, -0.0000, 0.068, 0.0000]),
     ("interior#1", [0.0033, 0.0189, -0.0000, 0.058, 0.0000]),
 ];
 
