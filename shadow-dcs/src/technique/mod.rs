@@ -43,6 +43,8 @@ use shadow_core::light::{LightGeometry, LightKind, LightSample};
 use shadow_core::offset::RayOffset;
 use shadow_core::prelude::*;
 use shadow_core::rays::{PreparedRays, RayScratch, ShadowRays};
+use shadow_core::spatial_order::in_spatial_order;
+use shadow_core::stats::CorePhase;
 use shadow_core::technique::{Capabilities, Processor, SceneRef};
 use shadow_core::view_samples::ViewSample;
 use shadow_core::visibility::PixelClass;
@@ -646,12 +648,24 @@ impl PreparedShadows for PreparedDcs {
         self.p.light.as_ref()
     }
 
+    /// A caller's points are estimated in a spatial order, so that each square of the wedge
+    /// scan holds receivers close in space ([`in_spatial_order`]); their direct light too, in
+    /// the same order, when asked for.
     fn pass(&self, view: &ViewSamples, outputs: Outputs) -> Result<Estimate, TechniqueError> {
         let output = match self.config.output {
             PerSampleOutput::None if outputs.per_sample => PerSampleOutput::Bits,
             o => o,
         };
-        self.config.run(&self.p, view, output)
+        in_spatial_order(view, |v| {
+            let mut est = self.config.run(&self.p, v, output)?;
+            if outputs.direct && view.raster_view().is_none() {
+                let t0 = std::time::Instant::now();
+                est.direct = Some(self.config.direct(&self.p, v)?);
+                est.stats
+                    .add_time(CorePhase::Direct, t0.elapsed().as_secs_f64());
+            }
+            Ok(est)
+        })
     }
 
     fn direct_light(&self, view: &ViewSamples, _: &Estimate) -> Result<Vec<Vec3>, TechniqueError> {
