@@ -296,10 +296,15 @@ fn bad_receivers_are_typed_errors_naming_the_receiver() {
     assert!(ViewSamples::from_gbuffer(scene, &g, ok).is_ok());
 }
 
+/// Screen-space selection needs a camera and refuses points with a typed reason; DCS counts
+/// each point's integration constant along its own segment (section 4.1) and, on shuffled
+/// points, gives per-sample visibility and direct light bit for bit as the reference on the
+/// same light samples.
 #[test]
-fn techniques_that_need_a_camera_refuse_points_with_a_typed_reason() {
+fn points_are_refused_only_by_screen_space_selection_and_dcs_answers_them_exactly() {
     let (setup, view) = scene_and_view("bunny");
-    let receivers: Vec<usize> = (0..view.len()).filter(|&i| view.is_valid(i)).collect();
+    let mut receivers: Vec<usize> = (0..view.len()).filter(|&i| view.is_valid(i)).collect();
+    receivers.sort_by_key(|&i| (i as u64).wrapping_mul(0x2545_F491_4F6C_DD1D));
     let (positions, normals) = points_of(&view, &receivers);
     let points = ViewSamples::from_points(
         setup.scene.as_ref(),
@@ -308,15 +313,59 @@ fn techniques_that_need_a_camera_refuse_points_with_a_typed_reason() {
         Snapping::for_scene(setup.scene.as_ref()),
     )
     .unwrap();
-    for name in ["dcs-64", "ssm-adaptive"] {
+    let prepare = |name: &str| {
         let technique = (shadow_presets::preset(name).unwrap().make)(1);
         let prepared = technique
             .prepare(setup.scene.clone(), setup.lights[0].clone())
             .unwrap();
-        let e = prepared.estimate(&points, Outputs::VISIBILITY).unwrap_err();
-        assert!(
-            matches!(e.unsupported_reason(), Some(UnsupportedReason::View(_))),
-            "{name}: {e}"
-        );
+        (technique, prepared)
+    };
+    let (_, ssm) = prepare("ssm-adaptive");
+    let e = ssm.estimate(&points, Outputs::VISIBILITY).unwrap_err();
+    assert!(
+        matches!(e.unsupported_reason(), Some(UnsupportedReason::View(_))),
+        "ssm-adaptive: {e}"
+    );
+    let (dcs, dcs_prepared) = prepare("dcs-64");
+    let both = Outputs {
+        per_sample: true,
+        direct: true,
+    };
+    let d = dcs_prepared.estimate(&points, both).unwrap();
+    let reference = Reference::same_samples(dcs.light_sampler().unwrap().clone())
+        .prepare(setup.scene.clone(), setup.lights[0].clone())
+        .unwrap()
+        .estimate(&points, both)
+        .unwrap();
+    let (pd, pr) = (
+        d.visibility.per_sample().unwrap(),
+        reference.visibility.per_sample().unwrap(),
+    );
+    let n = dcs.light_sampler().unwrap().count();
+    let mut disagree = 0u64;
+    for i in 0..points.len() {
+        for k in 0..n {
+            disagree += u64::from(pd.visible(i, k) != pr.visible(i, k));
+        }
     }
+    let total = points.valid_count() as u64 * u64::from(n);
+    assert!(
+        disagree * 10_000 <= total,
+        "dcs-64 on points: {disagree} of {total} samples differ from the reference"
+    );
+    let (dd, dr) = (d.direct.unwrap(), reference.direct.unwrap());
+    let off = dd
+        .iter()
+        .zip(&dr)
+        .filter(|(a, b)| (**a - **b).abs().max_element() > 1e-4 * (1.0 + b.max_element()))
+        .count();
+    assert!(
+        off * 1000 <= points.len(),
+        "{off} receivers' direct light differ"
+    );
+    assert!(
+        d.stats
+            .counter(shadow_dcs::DcsCounter::ReceiverConstantSegments)
+            > Some(0)
+    );
 }

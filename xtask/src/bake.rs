@@ -31,7 +31,7 @@ pub struct BakeArgs {
     /// The lightmap's side in texels.
     #[arg(long)]
     size: u32,
-    /// Technique preset; it must take receivers without a camera (not DCS or `ssm-adaptive`).
+    /// Technique preset; it must take receivers without a camera (not `ssm-adaptive`).
     #[arg(long, default_value = "ref")]
     technique: String,
     /// Samples per texel, for presets with a sample count.

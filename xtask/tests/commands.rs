@@ -715,14 +715,15 @@ fn render_takes_a_foreign_gbuffer_and_answers_as_on_its_own_view() {
         "mean difference {}",
         sum / f64::from(n)
     );
-    // Without the camera they were rendered with, DCS cannot count its shadow volumes.
-    let refused = temp_dir("gbuffer-dcs");
+    // Without the camera they were rendered with, screen-space selection has no image to work
+    // in (DCS counts each receiver's constant along its own segment instead).
+    let refused = temp_dir("gbuffer-ssm-adaptive");
     let out = xtask(&[
         "render",
         "--scene",
         "bunny",
         "--technique",
-        "dcs-64",
+        "ssm-adaptive",
         "--gbuffer",
         own.to_str().unwrap(),
         "--out",
