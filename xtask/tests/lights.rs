@@ -184,7 +184,14 @@ fn bake_refusals_say_why() {
         assert!(!out.status.success());
         String::from_utf8_lossy(&out.stderr).to_string()
     };
-    let e = run(&["--mesh", "floor", "--size", "16", "--technique", "ssm-adaptive"]);
+    let e = run(&[
+        "--mesh",
+        "floor",
+        "--size",
+        "16",
+        "--technique",
+        "ssm-adaptive",
+    ]);
     assert!(e.contains("no camera"), "{e}");
     let e = run(&["--mesh", "ceiling", "--size", "16"]);
     assert!(e.contains("meshes with them: floor"), "{e}");
