@@ -520,41 +520,6 @@ impl Dcs {
     }
 }
 
-/// Copies each square's values (`values` of each of `squares`, `per_pixel` of them per pixel,
-/// row by row within the square) into `out`, the image's values (`width` pixels a row), bands
-/// of [`SQUARE`] rows in parallel. Nothing is copied when `out` is empty (an output not asked
-/// for).
-fn scatter_squares<T: Copy + Send + Sync, R: Sync>(
-    out: &mut [T],
-    per_pixel: usize,
-    width: usize,
-    squares: &[(Rect, R)],
-    values: impl Fn(&R) -> &[T] + Sync,
-) {
-    let row = width * per_pixel;
-    if out.is_empty() || row == 0 {
-        return;
-    }
-    let band = SQUARE as usize;
-    let mut bands: Vec<Vec<(Rect, &[T])>> = vec![Vec::new(); (out.len() / row).div_ceil(band)];
-    for (r, square) in squares {
-        bands[r.rows.0 as usize / band].push((*r, values(square)));
-    }
-    out.par_chunks_mut(band * row)
-        .zip(bands.par_iter())
-        .for_each(|(chunk, band_squares)| {
-            for (r, v) in band_squares {
-                let (x0, rw) = (
-                    r.cols.0 as usize * per_pixel,
-                    r.width() as usize * per_pixel,
-                );
-                for (k, src) in v.chunks_exact(rw).enumerate() {
-                    chunk[k * row + x0..k * row + x0 + rw].copy_from_slice(src);
-                }
-            }
-        });
-}
-
 /// The samples of `positions` above the tangent plane both from the surface point and from the
 /// offset `origin` (the reference's rule), one bit each, into `above`.
 fn horizon_mask_into(positions: &[Vec3], s: &ViewSample, origin: Vec3, above: &mut Vec<u64>) {
@@ -717,11 +682,11 @@ mod tests {
                 })
                 .collect();
             let mut out = vec![usize::MAX; (w * h) as usize * per_pixel];
-            scatter_squares(&mut out, per_pixel, w as usize, &values, |v| v);
+            output::scatter_squares(&mut out, per_pixel, w as usize, &values, |v| v);
             assert!(out.iter().enumerate().all(|(i, v)| *v == i));
         }
         let mut none: Vec<u64> = Vec::new();
-        scatter_squares(&mut none, 1, w as usize, &[(squares[0], vec![7u64])], |v| v);
+        output::scatter_squares(&mut none, 1, w as usize, &[(squares[0], vec![7u64])], |v| v);
         assert!(none.is_empty());
     }
 

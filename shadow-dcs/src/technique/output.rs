@@ -3,10 +3,11 @@
 //! square is done, and the pass's counts as statistics.
 
 use glam::Vec3;
+use rayon::prelude::*;
 use shadow_core::prelude::*;
 use shadow_core::visibility::{PerSampleVisibility, PixelClass};
 
-use super::{Counts, PerSampleOutput, Scratch, scatter_squares};
+use super::{Counts, PerSampleOutput, SQUARE, Scratch};
 use crate::accel::bins::Rect;
 use crate::statistics::DcsCounter;
 
@@ -199,4 +200,39 @@ pub(super) fn record_counts(
     stats.add(DcsCounter::RefinedLineCells, counts.line_cells);
     stats.add(DcsCounter::PixelsSharedSampleSets, counts.shared_set_pixels);
     stats.add(DcsCounter::SharedSampleSetsBuilt, counts.shared_sets_built);
+}
+
+/// Copies each square's values (`values` of each of `squares`, `per_pixel` of them per pixel,
+/// row by row within the square) into `out`, the image's values (`width` pixels a row), bands
+/// of [`SQUARE`] rows in parallel. Nothing is copied when `out` is empty (an output not asked
+/// for).
+pub(super) fn scatter_squares<T: Copy + Send + Sync, R: Sync>(
+    out: &mut [T],
+    per_pixel: usize,
+    width: usize,
+    squares: &[(Rect, R)],
+    values: impl Fn(&R) -> &[T] + Sync,
+) {
+    let row = width * per_pixel;
+    if out.is_empty() || row == 0 {
+        return;
+    }
+    let band = SQUARE as usize;
+    let mut bands: Vec<Vec<(Rect, &[T])>> = vec![Vec::new(); (out.len() / row).div_ceil(band)];
+    for (r, square) in squares {
+        bands[r.rows.0 as usize / band].push((*r, values(square)));
+    }
+    out.par_chunks_mut(band * row)
+        .zip(bands.par_iter())
+        .for_each(|(chunk, band_squares)| {
+            for (r, v) in band_squares {
+                let (x0, rw) = (
+                    r.cols.0 as usize * per_pixel,
+                    r.width() as usize * per_pixel,
+                );
+                for (k, src) in v.chunks_exact(rw).enumerate() {
+                    chunk[k * row + x0..k * row + x0 + rw].copy_from_slice(src);
+                }
+            }
+        });
 }
