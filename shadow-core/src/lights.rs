@@ -148,6 +148,21 @@ impl PreparedLights {
         view: &ViewSamples,
         outputs: Outputs,
     ) -> Result<LightsEstimate, TechniqueError> {
+        self.estimate_with_progress(view, outputs, &mut |_, _| Ok(()))
+    }
+
+    /// [`PreparedLights::estimate`], calling `progress(lights_done, lights)` after each light;
+    /// an error from `progress` stops the estimate there and is returned (a caller's
+    /// cancellation: a Python `KeyboardInterrupt`, a closed window).
+    ///
+    /// # Errors
+    /// As [`PreparedLights::estimate`], and `progress`'s error unchanged.
+    pub fn estimate_with_progress(
+        &self,
+        view: &ViewSamples,
+        outputs: Outputs,
+        progress: &mut dyn FnMut(usize, usize) -> Result<(), TechniqueError>,
+    ) -> Result<LightsEstimate, TechniqueError> {
         let mut stats = Stats::default();
         let mut direct = outputs.direct.then(|| vec![Vec3::ZERO; view.len()]);
         let mut lights = Vec::with_capacity(self.lights.len());
@@ -179,6 +194,7 @@ impl PreparedLights {
                 skipped,
                 estimate,
             });
+            progress(lights.len(), self.lights.len())?;
         }
         Ok(LightsEstimate {
             lights,

@@ -5,7 +5,8 @@
 //!   textures) and Wavefront OBJ, into a validated [`SceneSetup`], every size a file declares
 //!   checked against [`LoadLimits`] before anything is allocated;
 //! * [`image_io`]: float EXR and 8-bit PNG output of visibility buffers, view-sample AOVs and
-//!   shaded images.
+//!   shaded images;
+//! * [`npy`]: NumPy `.npy` output of visibility buffers.
 //!
 //! It depends on `shadow-core` alone, so a renderer that takes one technique crate and this
 //! one builds neither the reference, the GPU stack nor the harness.
@@ -24,5 +25,6 @@
 
 pub mod image_io;
 pub mod load;
+pub mod npy;
 
 pub use load::{LoadError, LoadLimits, SceneSetup, load_scene};

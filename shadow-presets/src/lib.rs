@@ -63,6 +63,53 @@ pub fn build(
     }
 }
 
+/// The family of a preset name: what comes before its first `-` (`dcs-64` is a `dcs`).
+pub fn family_of(name: &str) -> &str {
+    name.split('-').next().unwrap_or(name)
+}
+
+/// A preset by name, or a family by name (`ref`, `dcs`, `afsm`: the family's preset whose
+/// sample count can be set), with `seed` and optionally another sample count: what the
+/// command line's `--technique` and the Python package's `technique` accept.
+///
+/// # Errors
+/// [`TechniqueError::InvalidInput`] for an unknown name (listing the valid ones), a fixed
+/// sample count (naming the family to use instead), or a count the technique refuses.
+pub fn resolve(
+    name: &str,
+    samples: Option<u32>,
+    seed: u64,
+) -> Result<Box<dyn ShadowTechnique>, TechniqueError> {
+    let all = registry();
+    let settable = |family: &str| {
+        all.iter()
+            .find(|p| family_of(p.name) == family && p.with_samples.is_some())
+            .copied()
+    };
+    let p = match preset(name) {
+        Ok(p) => p,
+        Err(unknown) => settable(name).ok_or(TechniqueError::InvalidInput(unknown))?,
+    };
+    match samples {
+        None => Ok((p.make)(seed)),
+        Some(n) => match p.with_samples {
+            Some(f) => f(n, seed).map_err(|e| {
+                TechniqueError::InvalidInput(format!("technique `{name}` at {n} samples: {e}"))
+            }),
+            None => Err(TechniqueError::InvalidInput(
+                match settable(family_of(p.name)) {
+                    Some(_) => format!(
+                        "technique `{name}` has a fixed sample count; use its family: `{}` \
+                         with {n} samples",
+                        family_of(p.name)
+                    ),
+                    None => format!("technique `{name}` has no sample count to set"),
+                },
+            )),
+        },
+    }
+}
+
 /// The preset called `name`.
 ///
 /// # Errors
@@ -191,6 +238,22 @@ impl std::fmt::Debug for Preset {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn resolve_takes_presets_and_families_with_a_count() {
+        let r = resolve("ref", Some(16), 1).unwrap();
+        assert_eq!(r.light_sampler().map(|s| s.count()), Some(16));
+        assert_eq!(resolve("dcs-64", None, 1).unwrap().name(), "dcs-64");
+        let msg = |e: TechniqueError| match e {
+            TechniqueError::InvalidInput(m) => m,
+            e => panic!("not invalid input: {e}"),
+        };
+        let fixed = msg(resolve("dcs-64", Some(32), 1).err().unwrap());
+        assert!(fixed.contains("use its family: `dcs`"), "{fixed}");
+        let unknown = msg(resolve("nope", None, 1).err().unwrap());
+        assert!(unknown.contains("valid names: ref"), "{unknown}");
+        assert_eq!(family_of("ssm-contours"), "ssm");
+    }
 
     const TABLE: &[(&str, [f64; 5])] = &[
         ("bunny", [0.01, 0.02, 0.0, 0.1, 0.001]),

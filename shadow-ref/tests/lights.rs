@@ -180,3 +180,39 @@ fn no_lights_is_an_error() {
     let e = PreparedLights::prepare(&r, None, setup.scene.clone(), &[]).unwrap_err();
     assert!(matches!(e, TechniqueError::InvalidInput(_)));
 }
+
+#[test]
+fn progress_is_reported_after_each_light_and_its_error_stops_the_estimate() {
+    let (setup, view) = interior();
+    let r = Reference::stratified(4, 5).unwrap();
+    let all = PreparedLights::prepare(&r, None, setup.scene.clone(), &setup.lights).unwrap();
+    let mut calls = Vec::new();
+    let est = all
+        .estimate_with_progress(&view, Outputs::VISIBILITY, &mut |done, total| {
+            calls.push((done, total));
+            Ok(())
+        })
+        .unwrap();
+    assert_eq!(calls, [(1, 3), (2, 3), (3, 3)]);
+    let plain = all.estimate(&view, Outputs::VISIBILITY).unwrap();
+    for (a, b) in est.lights.iter().zip(&plain.lights) {
+        assert_eq!(
+            a.estimate.visibility.coefficients(),
+            b.estimate.visibility.coefficients()
+        );
+    }
+    let mut seen = 0;
+    let stopped = all.estimate_with_progress(&view, Outputs::VISIBILITY, &mut |done, _| {
+        seen = done;
+        if done == 2 {
+            Err(TechniqueError::InvalidInput("cancelled".into()))
+        } else {
+            Ok(())
+        }
+    });
+    assert_eq!(seen, 2, "no light after the cancelling one");
+    assert_eq!(
+        stopped.unwrap_err(),
+        TechniqueError::InvalidInput("cancelled".into())
+    );
+}

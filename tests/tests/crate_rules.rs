@@ -55,6 +55,16 @@ fn allowed() -> BTreeMap<&'static str, &'static [&'static str]> {
                 "shadow-auto",
             ],
         ),
+        // The Python package converts arrays and calls the crates (no technique of its own).
+        (
+            "shadow-python",
+            &[
+                "shadow-core",
+                "shadow-io",
+                "shadow-scenes",
+                "shadow-presets",
+            ],
+        ),
     ])
 }
 

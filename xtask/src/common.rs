@@ -65,42 +65,17 @@ pub fn resolve_scene(
     Ok(setup)
 }
 
-/// The family of a preset name: what comes before its first `-` (`dcs-64` is a `dcs`).
-fn family_of(name: &str) -> &str {
-    name.split('-').next().unwrap_or(name)
-}
-
-/// A preset by name, or a family by name (`ref`, `dcs`, `afsm`: the family's preset whose
-/// sample count can be set), optionally with another sample count.
+/// A preset by name, or a family by name, optionally with another sample count
+/// ([`shadow_presets::resolve`]).
 pub fn resolve_technique(
     name: &str,
     samples: Option<u32>,
     seed: u64,
 ) -> Result<Box<dyn ShadowTechnique>, String> {
-    let all = shadow_presets::registry();
-    let settable = |family: &str| {
-        all.iter()
-            .find(|p| family_of(p.name) == family && p.with_samples.is_some())
-            .copied()
-    };
-    let p = match shadow_presets::preset(name) {
-        Ok(p) => p,
-        Err(unknown) => settable(name).ok_or(unknown)?,
-    };
-    match samples {
-        None => Ok((p.make)(seed)),
-        Some(n) => match p.with_samples {
-            Some(f) => f(n, seed).map_err(|e| format!("technique `{name}` at {n} samples: {e}")),
-            None => Err(match settable(family_of(p.name)) {
-                Some(_) => format!(
-                    "technique `{name}` has a fixed sample count; use its family: `--technique {} \
-                     --samples {n}`",
-                    family_of(p.name)
-                ),
-                None => format!("technique `{name}` has no sample count to set"),
-            }),
-        },
-    }
+    shadow_presets::resolve(name, samples, seed).map_err(|e| match e {
+        TechniqueError::InvalidInput(m) => m,
+        e => e.to_string(),
+    })
 }
 
 /// Prints the built-in scenes.

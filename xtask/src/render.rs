@@ -13,6 +13,7 @@ use shadow_io::image_io::{
     write_normal_exr, write_position_exr, write_radiance_png, write_rgb_exr, write_shaded_png,
     write_visibility_exr, write_visibility_png,
 };
+use shadow_io::npy::write_visibility_npy;
 
 use crate::common::{
     machine, progress, rays_per_second_per_thread, resolve_scene, resolve_technique, write_json,
@@ -95,11 +96,12 @@ pub struct RenderArgs {
 }
 
 /// Every file a render may write; each run removes them first.
-const OUTPUTS: [&str; 10] = [
+const OUTPUTS: [&str; 11] = [
     "position.exr",
     "normal.exr",
     "stats.json",
     "visibility.exr",
+    "visibility.npy",
     "visibility.png",
     "shaded.png",
     "direct.exr",
@@ -129,7 +131,9 @@ pub(crate) fn write_receivers(
 pub(crate) fn remove_outputs(out: &std::path::Path) -> Result<(), String> {
     let per_light = |name: &str| {
         name.strip_prefix("visibility-").is_some_and(|rest| {
-            let k = rest.trim_end_matches(".exr").trim_end_matches(".png");
+            let k = [".exr", ".npy", ".png"]
+                .iter()
+                .fold(rest, |k, ext| k.trim_end_matches(ext));
             !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit())
         })
     };
@@ -507,8 +511,8 @@ fn write_lights(
         .map_err(|e| e.to_string())
 }
 
-/// Writes V: `visibility.exr` and `.png` for one light, `visibility-K.*` for the scene's light
-/// K of several.
+/// Writes V: `visibility.exr`, `.npy` and `.png` for one light, `visibility-K.*` for the
+/// scene's light K of several.
 pub(crate) fn write_visibilities(
     out: &std::path::Path,
     indices: &[usize],
@@ -523,6 +527,7 @@ pub(crate) fn write_visibilities(
         };
         let v = &each.estimate.visibility;
         write_visibility_exr(&out.join(format!("{stem}.exr")), v).map_err(|e| e.to_string())?;
+        write_visibility_npy(&out.join(format!("{stem}.npy")), v).map_err(|e| e.to_string())?;
         write_visibility_png(&out.join(format!("{stem}.png")), v).map_err(|e| e.to_string())?;
     }
     Ok(())
