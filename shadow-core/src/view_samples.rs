@@ -93,7 +93,26 @@ impl ViewSamples {
         height: u32,
     ) -> Result<Self, RasterError> {
         let view = camera.raster_view(width, height);
-        Self::render_view(scene, &view)
+        let mut samples = Self::render_view(scene, &view)?;
+        if let Some(far) = camera.far() {
+            samples.clip_beyond(far);
+        }
+        Ok(samples)
+    }
+
+    /// Makes every pixel whose surface lies deeper than `far` background: the nearest surface
+    /// of a pixel is its nearest within the far plane or none, so clipping the nearest is
+    /// clipping every fragment.
+    fn clip_beyond(&mut self, far: f32) {
+        for i in 0..self.triangle.len() {
+            if self.triangle[i] != NO_TRIANGLE && self.depth[i] > far {
+                self.triangle[i] = NO_TRIANGLE;
+                self.position[i] = Vec3::ZERO;
+                self.geometric_normal[i] = Vec3::ZERO;
+                self.shading_normal[i] = Vec3::ZERO;
+                self.depth[i] = f32::INFINITY;
+            }
+        }
     }
 
     /// Renders the view samples for any raster view (perspective or orthographic).

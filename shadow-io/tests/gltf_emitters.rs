@@ -268,3 +268,70 @@ fn a_zero_area_emitter_says_so() {
         }
     }
 }
+
+/// Issue 69 item 4: a planar emitter with a vertex no triangle uses, or with a zero-area
+/// triangle stitched in, is still the rectangle it draws (not a mesh light).
+#[test]
+fn an_unused_vertex_or_a_zero_area_triangle_keeps_a_planar_light_planar() {
+    use shadow_io::load::light_from_emissive_mesh;
+    let quad = [
+        Vec3::new(-0.5, 0.0, -0.5),
+        Vec3::new(0.5, 0.0, -0.5),
+        Vec3::new(0.5, 0.0, 0.5),
+        Vec3::new(-0.5, 0.0, 0.5),
+    ];
+    let tris = [[0, 1, 2], [0, 2, 3]];
+    let plain = light_from_emissive_mesh("lamp", &quad, &tris, Vec3::ONE, None).unwrap();
+    assert_eq!(plain.kind(), LightKind::Rectangle);
+    // An unused vertex far off the plane.
+    let mut stray = quad.to_vec();
+    stray.push(Vec3::new(3.0, 7.0, -2.0));
+    let with_stray = light_from_emissive_mesh("lamp", &stray, &tris, Vec3::ONE, None).unwrap();
+    // A zero-area triangle along an edge (a repeated vertex).
+    let sliver = [[0, 1, 2], [0, 2, 3], [1, 2, 2]];
+    let with_sliver = light_from_emissive_mesh("lamp", &quad, &sliver, Vec3::ONE, None).unwrap();
+    for light in [with_stray, with_sliver] {
+        assert_eq!(light.kind(), LightKind::Rectangle);
+        assert_eq!(light.area(), plain.area());
+        assert_eq!(light.center(), plain.center());
+    }
+}
+
+/// Issue 69 item 12: a NaN vertex in an emitter is named as such, not as "no area".
+#[test]
+fn a_nan_light_vertex_is_named_as_not_finite() {
+    use shadow_io::load::light_from_emissive_mesh;
+    let positions = [Vec3::ZERO, Vec3::X, Vec3::new(0.0, f32::NAN, 1.0)];
+    let err =
+        light_from_emissive_mesh("lamp", &positions, &[[0, 2, 1]], Vec3::ONE, None).unwrap_err();
+    let text = err.to_string();
+    assert!(
+        text.contains("vertex 2") && text.contains("not finite"),
+        "{text}"
+    );
+    assert!(!text.contains("no area"), "{text}");
+}
+
+/// Issue 69 item 7: a file whose every mesh emits (DamagedHelmet) says what to do, and loads
+/// as geometry when asked.
+#[test]
+fn a_file_of_emissive_meshes_only_says_what_to_do() {
+    let mut w = Writer::default();
+    let lamp = w.material(json!({"emissiveFactor": [1.0, 1.0, 1.0]}));
+    let (sp, si) = square(0.5);
+    w.mesh("visor", &sp, &si, None, lamp);
+    let doc = w.document(json!([{"mesh": 0}]), json!([]));
+    let err = load(&doc).unwrap_err().to_string();
+    assert!(
+        err.contains("every mesh of the file emits light (1 became lights)")
+            && err.contains("--emissive-as-geometry")
+            && err.contains("--light"),
+        "{err}"
+    );
+    let limits = LoadLimits {
+        emissive_as_geometry: true,
+        ..LoadLimits::default()
+    };
+    let setup = load_gltf_slice(doc.to_string().as_bytes(), None, "t", &limits).unwrap();
+    assert_eq!((setup.scene.triangle_count(), setup.lights.len()), (2, 0));
+}

@@ -160,8 +160,9 @@ fn glb_and_external_buffers_load() {
     let bin = base64::engine::general_purpose::STANDARD
         .decode(uri.split_once(";base64,").unwrap().1)
         .unwrap();
-    std::fs::write(dir.join("scene data.bin"), &bin).unwrap();
-    doc["buffers"][0]["uri"] = json!("scene%20data.bin");
+    // Percent-encoded bytes other than spaces decode too (issue 69 item 11).
+    std::fs::write(dir.join("scene data#1+\u{fc}.bin"), &bin).unwrap();
+    doc["buffers"][0]["uri"] = json!("scene%20data%231%2B%C3%BC.bin");
     std::fs::write(dir.join("scene.gltf"), doc.to_string()).unwrap();
     let external = load_gltf(&dir.join("scene.gltf"), &LoadLimits::default()).unwrap();
     assert_eq!(external.lights.len(), 3);
@@ -177,7 +178,7 @@ fn glb_and_external_buffers_load() {
     std::fs::write(dir.join("cut.glb"), &glb[..glb.len() / 2]).unwrap();
     assert!(load_gltf(&dir.join("cut.glb"), &LoadLimits::default()).is_err());
     // Missing external buffer.
-    std::fs::remove_file(dir.join("scene data.bin")).unwrap();
+    std::fs::remove_file(dir.join("scene data#1+\u{fc}.bin")).unwrap();
     assert!(matches!(
         load_gltf(&dir.join("scene.gltf"), &LoadLimits::default()),
         Err(LoadError::Io { .. })

@@ -176,3 +176,17 @@ fn out_of_range_texture_and_normal_indices_are_errors_not_overflows() {
         assert!(e.contains(what), "{e}");
     }
 }
+
+/// Issue 69 item 10: a one-component `vt` (legal OBJ) and a Latin-1 byte in a comment load.
+#[test]
+fn a_one_component_vt_and_a_latin1_comment_load() {
+    let mut bytes = b"# caf".to_vec();
+    bytes.push(0xE9); // Latin-1 e-acute: not UTF-8
+    bytes.extend_from_slice(b"\nv 0 0 0\nv 1 0 0\nv 0 0 1\nvt 0.5\nvt 0.25\nvt 1\nf 1/1 3/2 2/3\n");
+    let setup = load_obj_slice(&bytes, "latin", &LoadLimits::default()).unwrap();
+    assert_eq!(setup.scene.triangle_count(), 1);
+    // A face naming a texture coordinate that does not exist is still refused, by line.
+    let bad = b"v 0 0 0\nv 1 0 0\nv 0 0 1\nvt 0.5\nf 1/1 3/2 2/1\n";
+    let err = load_obj_slice(bad, "bad", &LoadLimits::default()).unwrap_err();
+    assert!(err.to_string().contains("line 5"), "{err}");
+}

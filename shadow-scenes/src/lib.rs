@@ -479,11 +479,14 @@ fn moved(
                 w.matrix3.z_axis,
                 (Vec3::from(w.translation) * scale + translation).into(),
             );
-            let cam = Camera::from_world_transform(moved, c.yfov()).map_err(LoadError::from)?;
-            Some(match near {
-                Some(n) => cam.with_near(n).map_err(LoadError::from)?,
-                None => cam,
-            })
+            let mut cam = Camera::from_world_transform(moved, c.yfov()).map_err(LoadError::from)?;
+            if let Some(n) = near {
+                cam = cam.with_near(n).map_err(LoadError::from)?;
+            }
+            if let Some(f) = c.far() {
+                cam = cam.with_far(f * scale).map_err(LoadError::from)?;
+            }
+            Some(cam)
         }
         None => None,
     };

@@ -251,10 +251,11 @@ fn technique_for(a: &RenderArgs) -> Result<Option<Box<dyn ShadowTechnique>>, Str
 /// The receivers (the camera's view samples, or `--gbuffer`'s snapped onto the scene) and the
 /// seconds they took; an error when none is valid.
 fn view_for(a: &RenderArgs, setup: &SceneSetup, shift: Vec3) -> Result<(ViewSamples, f64), String> {
-    let height = a.height.unwrap_or_else(|| match setup.aspect {
-        Some(r) if r > 0.0 && r.is_finite() => ((a.width as f32 / r).round() as u32).max(1),
-        _ => (a.width * 3 / 4).max(1),
-    });
+    use shadow_core::view_samples::MAX_VIEW_PIXELS;
+    let height = match a.height {
+        Some(h) => h,
+        None => setup.image_height(a.width, MAX_VIEW_PIXELS)?,
+    };
     let camera = setup.camera_or_default();
     let t0 = Instant::now();
     let view = match &a.gbuffer {

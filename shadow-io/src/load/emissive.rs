@@ -59,6 +59,33 @@ pub fn light_from_emissive_mesh(
         return Err(unsupported("emissive mesh has no triangles"));
     }
     let constant = Radiance::constant(emission).map_err(light_err)?;
+    if let Some(v) = triangles
+        .iter()
+        .flatten()
+        .copied()
+        .find(|&v| !positions[v as usize].is_finite())
+    {
+        return Err(unsupported(&format!(
+            "vertex {v} of the emissive mesh is not finite ({:?})",
+            positions[v as usize]
+        )));
+    }
+    // What emits: triangles with area and the vertices they use. A vertex no triangle uses or
+    // a zero-area triangle (stitched strips have them) must not change the outline's shape.
+    let mut texture = texture;
+    let used = UsedGeometry::new(positions, triangles);
+    if let Some(t) = texture
+        .as_mut()
+        .filter(|t| t.texcoords.len() == positions.len())
+    {
+        t.texcoords = used.old_index.iter().map(|&i| t.texcoords[i]).collect();
+    }
+    let (positions, triangles) = (used.positions.as_slice(), used.triangles.as_slice());
+    if triangles.is_empty() {
+        return Err(unsupported(
+            "emissive mesh has no area: every triangle is degenerate",
+        ));
+    }
     let w = Welded::new(positions, triangles);
     if !(w.abs_area > 0.0) {
         return Err(unsupported(
@@ -119,6 +146,40 @@ impl Shape {
 }
 
 /// The mesh with exactly equal positions welded, and the sums its shape is read from.
+/// The triangles of a mesh that have area and only the vertices they use, renumbered.
+struct UsedGeometry {
+    positions: Vec<Vec3>,
+    triangles: Vec<[u32; 3]>,
+    /// The input index of each kept vertex.
+    old_index: Vec<usize>,
+}
+
+impl UsedGeometry {
+    fn new(positions: &[Vec3], triangles: &[[u32; 3]]) -> Self {
+        let mut new_index: Vec<Option<u32>> = vec![None; positions.len()];
+        let mut out = Self {
+            positions: Vec::new(),
+            triangles: Vec::new(),
+            old_index: Vec::new(),
+        };
+        for t in triangles {
+            let [a, b, c] = t.map(|v| positions[v as usize]);
+            if triangle_cross_f64(a, b, c).length_squared() == 0.0 {
+                continue;
+            }
+            let tri = t.map(|v| {
+                *new_index[v as usize].get_or_insert_with(|| {
+                    out.positions.push(positions[v as usize]);
+                    out.old_index.push(v as usize);
+                    (out.positions.len() - 1) as u32
+                })
+            });
+            out.triangles.push(tri);
+        }
+        out
+    }
+}
+
 struct Welded {
     positions: Vec<Vec3>,
     tris: Vec<[u32; 3]>,

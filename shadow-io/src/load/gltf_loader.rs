@@ -68,9 +68,22 @@ pub fn load_gltf_slice(
     walk.warnings = unread_extensions(&doc);
     walk.walk(&doc)?;
     if walk.occluders == 0 {
+        let reason = if walk.lights.is_empty() {
+            "the file has no geometry".to_string()
+        } else {
+            // A model whose every mesh has an emissive factor (DamagedHelmet's lit panels):
+            // nothing is left to cast or receive shadows.
+            format!(
+                "every mesh of the file emits light ({} became lights), so none is left as \
+                 geometry to shadow; to see the model lit, load its emissive meshes as geometry \
+                 (`--emissive-as-geometry`; `LoadLimits::emissive_as_geometry`; Python \
+                 `load(path, emissive_as_geometry=True)`) and give a light (`--light`)",
+                walk.lights.len()
+            )
+        };
         return Err(LoadError::Unsupported {
             mesh: name.to_string(),
-            reason: "the file has no non-emissive geometry".into(),
+            reason,
         });
     }
     let NodeWalk {

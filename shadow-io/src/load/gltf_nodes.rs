@@ -87,7 +87,7 @@ impl<'a> NodeWalk<'a> {
     pub fn walk(&mut self, doc: &gltf::Document) -> Result<(), LoadError> {
         let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
             Some(s) => s.nodes().collect(),
-            None => doc.nodes().collect(),
+            None => parentless(doc)?,
         };
         let mut stack: Vec<(gltf::Node, Mat4, u32)> = roots
             .into_iter()
@@ -160,10 +160,19 @@ impl<'a> NodeWalk<'a> {
     fn camera(&mut self, cam: &gltf::Camera, node: usize, world: Mat4) -> Result<(), LoadError> {
         match cam.projection() {
             gltf::camera::Projection::Perspective(p) => {
-                self.camera = Some(
+                let mut camera =
                     Camera::from_world_transform(Affine3A::from_mat4(world), p.yfov())?
-                        .with_near(p.znear())?,
-                );
+                        .with_near(p.znear())?;
+                if let Some(far) = p.zfar() {
+                    camera = camera.with_far(far)?;
+                }
+                if glam::Mat3::from_mat4(world).determinant() < 0.0 {
+                    self.warnings.push(format!(
+                        "camera on node {node} has a mirroring scale: it was removed, keeping \
+                         the camera's up and forward (the image is not mirrored left to right)"
+                    ));
+                }
+                self.camera = Some(camera);
                 self.aspect = p.aspect_ratio();
             }
             gltf::camera::Projection::Orthographic(_) => self.warnings.push(format!(
@@ -177,6 +186,16 @@ impl<'a> NodeWalk<'a> {
     /// else an occluder mesh (unless masked out).
     fn primitive(&mut self, p: Primitive) -> Result<(), LoadError> {
         let (prim, mesh_name) = (&p.prim, p.mesh_name);
+        // A node scaled to nothing (a hidden object) has no surface: skipped with a note.
+        if !(glam::Mat3::from_mat4(p.world).determinant().abs() >= f32::MIN_POSITIVE) {
+            self.warnings.push(format!(
+                "mesh `{mesh_name}` primitive {} on node {} has a zero scale (a hidden object) \
+                 and was skipped",
+                prim.index(),
+                p.node
+            ));
+            return Ok(());
+        }
         let pos_acc = prim.get(&Semantic::Positions).ok_or_else(|| {
             LoadError::Accessor(format!(
                 "mesh `{mesh_name}` primitive {} has no POSITION",
@@ -424,6 +443,29 @@ impl<'a> NodeWalk<'a> {
             gltf::material::AlphaMode::Opaque => Some(1.0),
         }
     }
+}
+
+/// The roots of a file without scenes: every node no node names as a child (glTF 2.0,
+/// "Scenes": without a scene, the nodes' hierarchy is still theirs).
+///
+/// # Errors
+/// [`LoadError::Gltf`] when every node is some node's child (the hierarchy is a cycle).
+fn parentless(doc: &gltf::Document) -> Result<Vec<gltf::Node<'_>>, LoadError> {
+    let mut child = vec![false; doc.nodes().len()];
+    for c in doc.nodes().flat_map(|n| n.children()) {
+        if let Some(flag) = child.get_mut(c.index()) {
+            *flag = true;
+        }
+    }
+    let roots: Vec<gltf::Node> = doc.nodes().filter(|n| !child[n.index()]).collect();
+    if roots.is_empty() && doc.nodes().len() > 0 {
+        return Err(LoadError::Gltf(
+            "the file has no scene and every node is some node's child: the node hierarchy \
+             has a cycle"
+                .into(),
+        ));
+    }
+    Ok(roots)
 }
 
 /// Adds the texture layout of `desc` (a primitive of node `node`) to `layouts`: the node's

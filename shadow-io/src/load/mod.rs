@@ -182,6 +182,28 @@ impl SceneSetup {
         })
     }
 
+    /// The height of an image `width` pixels wide: from the camera's declared aspect ratio
+    /// (width / height), else three quarters of the width; at least one pixel.
+    ///
+    /// # Errors
+    /// A message naming the aspect ratio when it gives a height over `max_pixels / width`
+    /// (an image no renderer could hold).
+    pub fn image_height(&self, width: u32, max_pixels: u64) -> Result<u32, String> {
+        let h = match self.aspect {
+            Some(r) if r > 0.0 && r.is_finite() => (f64::from(width) / f64::from(r)).round(),
+            _ => (f64::from(width) * 3.0 / 4.0).floor(),
+        };
+        let limit = max_pixels / u64::from(width.max(1));
+        if !(h <= limit as f64) {
+            return Err(format!(
+                "the camera's aspect ratio {} gives an image {width} wide and {h} high, over \
+                 the {max_pixels}-pixel limit: give the height",
+                self.aspect.unwrap_or(0.0)
+            ));
+        }
+        Ok((h as u32).max(1))
+    }
+
     /// The file's camera, or one looking at the scene's bounds from the front-top.
     pub fn camera_or_default(&self) -> Camera {
         use shadow_core::scene::Scene;

@@ -71,7 +71,8 @@ pub fn read_obj_mesh(
     if let Some((line, why)) = first_bad_line(bytes) {
         return Err(LoadError::Obj(format!("line {line}: {why}")));
     }
-    let mut reader = BufReader::new(bytes);
+    let text = readable_text(bytes);
+    let mut reader = BufReader::new(text.as_bytes());
     let (models, _) =
         tobj::load_obj_buf(&mut reader, &opts, |_| Err(tobj::LoadError::OpenFileFailed))
             .map_err(|e| LoadError::Obj(with_line(bytes, e.to_string())))?;
@@ -147,6 +148,29 @@ pub fn read_obj_mesh(
         return Err(LoadError::Obj("no faces".into()));
     }
     Ok((positions, triangles))
+}
+
+/// The OBJ text as `tobj` reads it: bytes that are not UTF-8 (a Latin-1 comment) replaced by
+/// U+FFFD, and a texture coordinate with one component (`vt u`, legal OBJ) given `v = 0`.
+/// Line numbers are kept.
+fn readable_text(bytes: &[u8]) -> std::borrow::Cow<'_, str> {
+    let text = String::from_utf8_lossy(bytes);
+    let one_component = |line: &str| {
+        let mut words = line.split_whitespace();
+        words.next() == Some("vt") && words.count() == 1
+    };
+    if !text.lines().any(one_component) {
+        return text;
+    }
+    let mut out = String::with_capacity(text.len() + 64);
+    for line in text.lines() {
+        out.push_str(line);
+        if one_component(line) {
+            out.push_str(" 0");
+        }
+        out.push('\n');
+    }
+    std::borrow::Cow::Owned(out)
 }
 
 /// `message` prefixed with the line of the first statement in `bytes` that cannot be read

@@ -1,5 +1,8 @@
 //! Shared by the glTF test files: a tiny glTF writer and a loader call.
 
+// Each test file takes the helpers it needs.
+#![allow(dead_code)]
+
 use std::io::Cursor;
 
 use base64::Engine;
