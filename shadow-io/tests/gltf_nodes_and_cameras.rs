@@ -144,3 +144,74 @@ fn an_extreme_aspect_ratio_is_named_not_a_huge_height() {
     let flat = load(&w.document(nodes, camera(1e9))).unwrap();
     assert_eq!(flat.image_height(512, limit), Ok(1));
 }
+
+/// Issue 69 item 2: morph targets and skins are applied in glTF's default pose (node weights
+/// over mesh weights; joints placed by the default scene, the skinned node's own transform
+/// ignored), not dropped for the bind pose.
+#[test]
+fn morph_targets_and_skins_take_the_default_pose() {
+    let mut w = writer();
+    let grey = w.material(json!({}));
+    let (sp, si) = square(0.5);
+    let morphed = w.mesh("morphed", &sp, &si, None, grey);
+    let skinned = w.mesh("skinned", &sp, &si, None, grey);
+    let bytes =
+        |values: &[f32]| -> Vec<u8> { values.iter().flat_map(|v| v.to_le_bytes()).collect() };
+    let up: Vec<f32> = (0..4).flat_map(|_| [0.0, 1.0, 0.0]).collect();
+    let up_view = w.view(&bytes(&up), None);
+    let target = w.accessor(
+        up_view,
+        5126,
+        4,
+        "VEC3",
+        json!({"min": [0.0, 1.0, 0.0], "max": [0.0, 1.0, 0.0]}),
+    );
+    let joints_view = w.view(&[0u8; 16], None);
+    let joints = w.accessor(joints_view, 5121, 4, "VEC4", json!({}));
+    let weights: Vec<f32> = (0..4).flat_map(|_| [1.0, 0.0, 0.0, 0.0]).collect();
+    let weights_view = w.view(&bytes(&weights), None);
+    let weights = w.accessor(weights_view, 5126, 4, "VEC4", json!({}));
+    let nodes = json!([
+        {"mesh": 0},
+        {"mesh": morphed, "translation": [2.0, 0.0, 0.0]},
+        {"mesh": skinned, "skin": 0, "translation": [100.0, 0.0, 0.0]},
+        {"translation": [-2.0, 2.0, 0.0]},
+        {"mesh": morphed, "translation": [0.0, 0.0, 2.0], "weights": [2.0]},
+    ]);
+    let mut doc = w.document(nodes, json!([]));
+    doc["meshes"][morphed]["primitives"][0]["targets"] = json!([{"POSITION": target}]);
+    doc["meshes"][morphed]["weights"] = json!([0.5]);
+    doc["meshes"][skinned]["primitives"][0]["attributes"]["JOINTS_0"] = json!(joints);
+    doc["meshes"][skinned]["primitives"][0]["attributes"]["WEIGHTS_0"] = json!(weights);
+    doc["skins"] = json!([{"joints": [3]}]);
+    let setup = load(&doc).unwrap();
+    let b = setup.scene.bounds();
+    assert_eq!(
+        b.max.x, 3.0,
+        "the skinned node's own translation is ignored"
+    );
+    let at = |x: f32, z: f32| -> Vec<f32> {
+        let s = setup.scene.as_ref();
+        (0..s.triangle_count())
+            .flat_map(|t| s.triangle(t))
+            .filter(|p| (p.x - x).abs() <= 0.5 && (p.z - z).abs() <= 0.5)
+            .map(|p| p.y)
+            .collect()
+    };
+    assert!(
+        at(2.0, 0.0).iter().all(|&y| y == 0.5),
+        "mesh weight 0.5: {:?}",
+        at(2.0, 0.0)
+    );
+    assert!(
+        at(0.0, 2.0).iter().all(|&y| y == 2.0),
+        "node weight 2: {:?}",
+        at(0.0, 2.0)
+    );
+    assert!(
+        at(-2.0, 0.0).iter().all(|&y| y == 2.0),
+        "placed by its joint: {:?}",
+        at(-2.0, 0.0)
+    );
+    assert!(!at(-2.0, 0.0).is_empty());
+}

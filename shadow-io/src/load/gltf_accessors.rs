@@ -158,3 +158,76 @@ pub(super) fn read_indices(
         })
         .collect())
 }
+
+/// Four joint indices per vertex (`JOINTS_n`: unsigned byte or short).
+pub(super) fn read_joints(
+    buffers: &[Vec<u8>],
+    acc: &gltf::Accessor,
+    limits: &LoadLimits,
+) -> Result<Vec<[u16; 4]>, LoadError> {
+    check_type(acc, Dimensions::Vec4, &[DataType::U8, DataType::U16])?;
+    let wide = acc.data_type() == DataType::U16;
+    Ok(elements(buffers, acc, limits)?
+        .into_iter()
+        .map(|b| {
+            std::array::from_fn(|k| {
+                if wide {
+                    u16::from_le_bytes([b[2 * k], b[2 * k + 1]])
+                } else {
+                    u16::from(b[k])
+                }
+            })
+        })
+        .collect())
+}
+
+/// Four weights per vertex (`WEIGHTS_n`: float, or normalized unsigned byte or short).
+pub(super) fn read_weights(
+    buffers: &[Vec<u8>],
+    acc: &gltf::Accessor,
+    limits: &LoadLimits,
+) -> Result<Vec<[f32; 4]>, LoadError> {
+    check_type(
+        acc,
+        Dimensions::Vec4,
+        &[DataType::F32, DataType::U8, DataType::U16],
+    )?;
+    let t = acc.data_type();
+    let out: Vec<[f32; 4]> = elements(buffers, acc, limits)?
+        .into_iter()
+        .map(|b| {
+            std::array::from_fn(|k| match t {
+                DataType::U8 => f32::from(b[k]) / 255.0,
+                DataType::U16 => f32::from(u16::from_le_bytes([b[2 * k], b[2 * k + 1]])) / 65535.0,
+                _ => f32_at(b, k),
+            })
+        })
+        .collect();
+    if out.iter().flatten().any(|w| !w.is_finite()) {
+        return Err(LoadError::Accessor(format!(
+            "accessor {} has non-finite weights",
+            acc.index()
+        )));
+    }
+    Ok(out)
+}
+
+/// Column-major 4x4 float matrices (a skin's inverse bind matrices).
+pub(super) fn read_mat4(
+    buffers: &[Vec<u8>],
+    acc: &gltf::Accessor,
+    limits: &LoadLimits,
+) -> Result<Vec<glam::Mat4>, LoadError> {
+    check_type(acc, Dimensions::Mat4, &[DataType::F32])?;
+    let out: Vec<glam::Mat4> = elements(buffers, acc, limits)?
+        .into_iter()
+        .map(|b| glam::Mat4::from_cols_array(&std::array::from_fn(|k| f32_at(b, k))))
+        .collect();
+    if out.iter().any(|m| !m.is_finite()) {
+        return Err(LoadError::Accessor(format!(
+            "accessor {} has non-finite matrices",
+            acc.index()
+        )));
+    }
+    Ok(out)
+}

@@ -47,6 +47,8 @@ pub(super) struct NodeWalk<'a> {
     vertices_total: u64,
     /// Occluder primitives loaded.
     pub occluders: usize,
+    /// Every node's world matrix in the walked scene, for skins' joints.
+    node_world: Vec<Option<Mat4>>,
 }
 
 /// One primitive of a mesh on a node.
@@ -55,6 +57,10 @@ struct Primitive<'p> {
     mesh_name: &'p str,
     node: usize,
     world: Mat4,
+    /// The default morph target weights (the node's, else the mesh's).
+    weights: &'p [f32],
+    /// The node's skin.
+    skin: Option<gltf::Skin<'p>>,
 }
 
 impl<'a> NodeWalk<'a> {
@@ -75,6 +81,7 @@ impl<'a> NodeWalk<'a> {
             untextured_albedo: Vec::new(),
             vertices_total: 0,
             occluders: 0,
+            node_world: Vec::new(),
         }
     }
 
@@ -89,6 +96,7 @@ impl<'a> NodeWalk<'a> {
             Some(s) => s.nodes().collect(),
             None => parentless(doc)?,
         };
+        self.node_world = super::gltf_pose::world_matrices(doc, &roots);
         let mut stack: Vec<(gltf::Node, Mat4, u32)> = roots
             .into_iter()
             .rev()
@@ -143,12 +151,15 @@ impl<'a> NodeWalk<'a> {
                 .name()
                 .map(str::to_string)
                 .unwrap_or_else(|| format!("mesh {}", mesh.index()));
+            let weights = node.weights().or_else(|| mesh.weights()).unwrap_or(&[]);
             for prim in mesh.primitives() {
                 self.primitive(Primitive {
                     prim,
                     mesh_name: &mesh_name,
                     node: node.index(),
                     world,
+                    weights,
+                    skin: node.skin(),
                 })?;
             }
         }
@@ -184,7 +195,8 @@ impl<'a> NodeWalk<'a> {
 
     /// One primitive: its triangles in the node's frame, then a light when its material emits,
     /// else an occluder mesh (unless masked out).
-    fn primitive(&mut self, p: Primitive) -> Result<(), LoadError> {
+    fn primitive(&mut self, mut p: Primitive) -> Result<(), LoadError> {
+        let positions = self.posed_positions(&mut p)?;
         let (prim, mesh_name) = (&p.prim, p.mesh_name);
         // A node scaled to nothing (a hidden object) has no surface: skipped with a note.
         if !(glam::Mat3::from_mat4(p.world).determinant().abs() >= f32::MIN_POSITIVE) {
@@ -196,13 +208,6 @@ impl<'a> NodeWalk<'a> {
             ));
             return Ok(());
         }
-        let pos_acc = prim.get(&Semantic::Positions).ok_or_else(|| {
-            LoadError::Accessor(format!(
-                "mesh `{mesh_name}` primitive {} has no POSITION",
-                prim.index()
-            ))
-        })?;
-        let positions = read_vec3(self.buffers, &pos_acc, self.limits)?;
         self.vertices_total += positions.len() as u64;
         if self.vertices_total > self.limits.max_vertices {
             return Err(LoadError::Limit {
@@ -244,6 +249,36 @@ impl<'a> NodeWalk<'a> {
         self.builder.push_mesh(desc)?;
         self.occluders += 1;
         Ok(())
+    }
+
+    /// The primitive's positions in glTF's default pose ([`super::gltf_pose`]): morphed by
+    /// the default weights, then skinned (and `p.world` made the identity, the joints having
+    /// placed them in the world).
+    fn posed_positions(&self, p: &mut Primitive) -> Result<Vec<Vec3>, LoadError> {
+        let (prim, mesh_name) = (&p.prim, p.mesh_name);
+        let pos_acc = prim.get(&Semantic::Positions).ok_or_else(|| {
+            LoadError::Accessor(format!(
+                "mesh `{mesh_name}` primitive {} has no POSITION",
+                prim.index()
+            ))
+        })?;
+        let named = |e: LoadError| LoadError::Accessor(format!("mesh `{mesh_name}`: {e}"));
+        let mut positions = read_vec3(self.buffers, &pos_acc, self.limits)?;
+        super::gltf_pose::morph(self.buffers, prim, p.weights, &mut positions, self.limits)
+            .map_err(named)?;
+        if let Some(skin) = &p.skin {
+            super::gltf_pose::skin(
+                self.buffers,
+                prim,
+                skin,
+                &self.node_world,
+                &mut positions,
+                self.limits,
+            )
+            .map_err(named)?;
+            p.world = Mat4::IDENTITY;
+        }
+        Ok(positions)
     }
 
     /// The primitive's triangles, wound so that a mirroring node keeps their front side, each

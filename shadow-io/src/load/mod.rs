@@ -10,6 +10,7 @@ mod emissive;
 mod gltf_accessors;
 mod gltf_loader;
 mod gltf_nodes;
+mod gltf_pose;
 mod obj;
 pub mod punctual;
 mod texture;
