@@ -23,13 +23,14 @@
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
+use shadow_core::geometry::ray_hits_triangle;
 use shadow_core::light::AreaLight;
 use shadow_core::offset::RayOffset;
 use shadow_core::prelude::*;
 use shadow_core::technique::UnsupportedReason;
 
 use crate::stages::constant::{eye_constant, integration_constants};
-use crate::stages::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
+use crate::stages::edges::{SceneEdge, Sides, Silhouettes, scene_edges, silhouettes};
 use crate::stages::light_shape::LightShape;
 use crate::stages::wedges::{Plane, wedge_planes};
 
@@ -112,7 +113,8 @@ pub fn paper_depth_complexity(
     let c = shape.center;
     let cd = c.as_dvec3();
     // Section 4.1: silhouettes for the light.
-    let (edges, units) = scene_edges(scene, c);
+    let one_sided = Sides::new(scene, &shape);
+    let (edges, units) = scene_edges(scene, &one_sided);
     let sil = silhouettes(&edges, &shape, detection);
     // The view samples' origins, offset off their surfaces as the reference's are.
     let offset = RayOffset::for_light(light);
@@ -130,7 +132,7 @@ pub fn paper_depth_complexity(
         .map(|o| (o.as_dvec3() - cd).as_vec3())
         .collect();
     // Section 4.1: the integration constant from the shadow-volume step.
-    let eye_c = eye_constant(scene, units, eye, c);
+    let eye_c = eye_constant(scene, units, &one_sided, eye, c);
     let (constants, _) = integration_constants(
         &edges, &sil, c, eye, eye_c, camera, &origins, &centred, &valid,
     );
@@ -175,6 +177,21 @@ pub fn paper_depth_complexity(
                     let (covered, t) = covers(o, cd, y.position.as_dvec3(), e.a, e.b);
                     tie[j] |= t;
                     if covered {
+                        depth[j] += k;
+                    }
+                }
+            }
+            // The faces the light may pass through, each tested against each sample's segment
+            // (stopping short of the sample as the reference's does): no wedge carries them.
+            for &t in &one_sided.explicit_list {
+                let [a, b, cc] = scene.triangle(t as usize).map(|v| v.as_dvec3());
+                let k = if units == 1 {
+                    1
+                } else {
+                    (scene.opacities()[t as usize].clamp(0.0, 1.0) * units as f32).ceil() as i64
+                };
+                for (j, y) in lights.iter().enumerate() {
+                    if ray_hits_triangle(o, y.position.as_dvec3() - o, a, b, cc, 1.0 - 1e-6) {
                         depth[j] += k;
                     }
                 }

@@ -17,6 +17,9 @@ shadow_core::statistics! {
         Edges => "edges",
         /// Edges on the silhouette seen from the light.
         SilhouetteEdges => "silhouette-edges",
+        /// Triangles the light may pass through (and their neighbours), tested against each
+        /// sample's segment instead of by wedges (a light in or set into a closed mesh).
+        ExplicitTriangles => "explicit-triangles",
         /// Preparations that reused another light's or technique's edges and silhouettes.
         PreparationShared => "preparation-shared",
         /// Estimates that reused a frame another estimate built.

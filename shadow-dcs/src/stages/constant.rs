@@ -27,7 +27,7 @@ use shadow_core::scene::Scene;
 
 use shadow_core::geometry::ray_hits_triangle;
 
-use crate::stages::edges::SceneEdge;
+use crate::stages::edges::{SceneEdge, Sides};
 
 /// Far vertices lie at this many times the largest eye or sample distance from `c`: a quad's
 /// far edge is a chord, and it stays beyond every view sample unless the edge subtends more
@@ -45,10 +45,16 @@ const SV_BAND: u32 = 8;
 /// `D(eye, c)`: the weighted crossings of the segment from the eye to the light centre, with the
 /// faces counted from the light's side (front faces of one-sided meshes, every face of
 /// two-sided ones).
-pub(crate) fn eye_constant(scene: &dyn Scene, edges_units: u32, eye: Vec3, c: Vec3) -> i64 {
+pub(crate) fn eye_constant(
+    scene: &dyn Scene,
+    edges_units: u32,
+    sides: &Sides,
+    eye: Vec3,
+    c: Vec3,
+) -> i64 {
     let (o, target) = (eye.as_dvec3(), c.as_dvec3());
     let d = target - o;
-    let rule = CrossingRule::new(scene, edges_units, target);
+    let rule = CrossingRule::new(scene, edges_units, sides, target);
     (0..scene.triangle_count())
         .into_par_iter()
         .map(|t| {
@@ -66,29 +72,34 @@ pub(crate) fn eye_constant(scene: &dyn Scene, edges_units: u32, eye: Vec3, c: Ve
 pub(crate) struct CrossingRule<'s> {
     scene: &'s dyn Scene,
     units: u32,
+    /// Which faces count from one side and which are tested explicitly.
+    sides: &'s Sides,
     target: DVec3,
     semi: bool,
 }
 
 impl<'s> CrossingRule<'s> {
-    /// The rule for segments toward `target` in `scene`, opacities in `units` per face.
-    pub(crate) fn new(scene: &'s dyn Scene, units: u32, target: DVec3) -> Self {
+    /// The rule for segments toward `target` in `scene`, opacities in `units` per face, the
+    /// faces counted as `sides` says.
+    pub(crate) fn new(scene: &'s dyn Scene, units: u32, sides: &'s Sides, target: DVec3) -> Self {
         Self {
             scene,
             units,
+            sides,
             target,
             semi: scene.has_semi_opaque(),
         }
     }
 
-    /// The weight of triangle `t`: 0 for the back (from the light) of a one-sided (closed,
-    /// consistently oriented) mesh, else 1, or its opacity in units when the scene is
+    /// The weight of triangle `t`: 0 for the back (from the light) of a one-sided mesh and for
+    /// a triangle tested explicitly, else 1, or its opacity in units when the scene is
     /// semi-opaque.
     pub(crate) fn weight(&self, t: usize) -> i64 {
+        if self.sides.explicit[t] {
+            return 0;
+        }
         let [a, b, cc] = self.scene.triangle(t).map(|v| v.as_dvec3());
-        let topo = self.scene.topology();
-        let comp = &topo.components()[topo.component_of(t)];
-        let one_sided = comp.closed && comp.consistently_oriented;
+        let one_sided = self.sides.one_sided[self.scene.topology().component_of(t)];
         let front_from_light = (b - a).cross(cc - a).dot(self.target - a) > 0.0;
         if one_sided && !front_from_light {
             0
@@ -299,7 +310,7 @@ fn near_zero(view: &RasterView, scale: f64) -> RasterView {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::stages::edges::{Silhouettes, scene_edges, silhouettes};
+    use crate::stages::edges::{Sides, Silhouettes, scene_edges, silhouettes};
     use crate::stages::light_shape::LightShape;
     use shadow_core::light::{Radiance, RectLight};
     use shadow_core::prelude::*;
@@ -336,7 +347,8 @@ mod tests {
         .unwrap();
         let view = ViewSamples::render(&scene, &cam, 64, 48).unwrap();
         let shape = LightShape::new(&light, "test").unwrap();
-        let (edges, units) = scene_edges(&scene, shape.center);
+        let one_sided = Sides::new(&scene, &shape);
+        let (edges, units) = scene_edges(&scene, &one_sided);
         let sil = silhouettes(&edges, &shape, Silhouettes::Accurate);
         let origins: Vec<Vec3> = (0..view.len())
             .map(|i| {
@@ -346,7 +358,7 @@ mod tests {
             .collect();
         let valid = view.valid_mask();
         let (eye, camera) = view.perspective().unwrap();
-        let eye_c = eye_constant(&scene, units, eye, shape.center);
+        let eye_c = eye_constant(&scene, units, &one_sided, eye, shape.center);
         let centred: Vec<Vec3> = origins
             .iter()
             .map(|o| (o.as_dvec3() - shape.center.as_dvec3()).as_vec3())
@@ -374,7 +386,7 @@ mod tests {
             for t in 0..scene.triangle_count() {
                 let [a, b, cc] = scene.triangle(t).map(|v| v.as_dvec3());
                 let back = (b - a).cross(cc - a).dot(p - a) < 0.0;
-                let closed = scene.is_closed_at(t);
+                let closed = one_sided.one_sided[scene.topology().component_of(t)];
                 if (!closed || back) && ray_hits_triangle(p, c - p, a, b, cc, 1.0) {
                     want += 1;
                 }

@@ -6,7 +6,10 @@
 //! counts) and on any other mesh every face: an open surface is treated as a two-sided closed
 //! shell, so the count stays a correct number of occluding layers whatever the topology. A closed
 //! mesh that contains the light centre is treated as two-sided as well (a segment may enter it
-//! without leaving). Weights are 1 for opaque scenes; with semi-opaque occluders each face
+//! without leaving), and so is one whose bounds overlap the light's: a light sample inside it,
+//! or a light partly set into it, is reached by a segment that enters the mesh and never
+//! leaves, which the one-sided count would miss ([`Sides`]); a face the light passes through
+//! is tested against each sample's segment instead. Weights are 1 for opaque scenes; with semi-opaque occluders each face
 //! weighs its opacity in units of `1/OPACITY_UNITS` (the paper's discretised opaqueness, section
 //! 4.4).
 //!
@@ -20,7 +23,8 @@
 //!
 //! Boundary and non-manifold edges, and edges whose faces differ in weight, always count.
 
-use glam::{DVec3, Vec3};
+use glam::DVec3;
+use shadow_core::geometry::Aabb;
 use shadow_core::scene::Scene;
 use shadow_core::topology::EdgeKind;
 
@@ -123,30 +127,124 @@ impl SceneEdge {
     }
 }
 
-/// Every edge of the scene with its faces, weights and two-sidedness for one light centre.
-pub(crate) fn scene_edges(scene: &dyn Scene, light_center: Vec3) -> (Vec<SceneEdge>, u32) {
+/// How a light's depth complexities count the scene's faces: which components count from one
+/// side, and which triangles the pass tests against every sample explicitly.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Sides {
+    /// Per topology component: a closed, consistently oriented mesh whose bounding box does
+    /// not overlap the light's counts only the faces turned away from the receiver. A segment
+    /// from a receiver outside such a mesh to a light sample outside it leaves it as often as
+    /// it enters, so that counts each layer once; a mesh that holds the light centre, a light
+    /// sample or part of the light (a lamp in a closed housing, a panel set into a ceiling
+    /// slab) breaks it, and counts both sides.
+    pub one_sided: Vec<bool>,
+    /// Per triangle: the triangle may meet the light itself, or shares an edge with one that
+    /// may. Where the light's surface passes through a face, a segment's end crosses the face
+    /// as the light sample moves, with no silhouette edge between (the count jumps along the
+    /// light, not at a wedge): such faces weigh nothing in the edges and the integration
+    /// constant and are tested against each sample's segment instead
+    /// ([`Sides::explicit_list`]).
+    pub explicit: Vec<bool>,
+    /// The indices of the `explicit` triangles.
+    pub explicit_list: Vec<u32>,
+}
+
+impl Sides {
+    /// The sides for the light of `shape` in `scene`.
+    pub(crate) fn new(scene: &dyn Scene, shape: &LightShape) -> Self {
+        let topo = scene.topology();
+        let mut bounds = vec![Aabb::empty(); topo.components().len()];
+        for t in 0..scene.triangle_count() {
+            let b = &mut bounds[topo.component_of(t)];
+            for p in scene.triangle(t) {
+                *b = b.grow(p);
+            }
+        }
+        let light = Aabb::from_points(&shape.hull).grow(shape.center);
+        let one_sided = topo
+            .components()
+            .iter()
+            .zip(&bounds)
+            .map(|(comp, b)| comp.closed && comp.consistently_oriented && !overlap(b, &light))
+            .collect();
+        let meets: Vec<bool> = (0..scene.triangle_count())
+            .map(|t| may_meet_light(scene.triangle(t), shape, &light))
+            .collect();
+        // With their neighbours across an edge: the edges a meeting face shares lie on the
+        // light or through its centre (a panel flush with a face, a light centred on a wall),
+        // where a wedge from the centre degenerates; the neighbours' far edges do not.
+        let mut explicit = meets.clone();
+        if meets.iter().any(|m| *m) {
+            for e in 0..topo.edge_count() {
+                let faces = topo.faces(e);
+                if faces.iter().any(|&t| meets[t as usize]) {
+                    for &t in faces {
+                        explicit[t as usize] = true;
+                    }
+                }
+            }
+        }
+        let explicit_list = (0..explicit.len() as u32)
+            .filter(|&t| explicit[t as usize])
+            .collect();
+        Self {
+            one_sided,
+            explicit,
+            explicit_list,
+        }
+    }
+
+    /// Every closed mesh one-sided and no explicit triangle (tests of the grid alone).
+    #[cfg(test)]
+    pub(crate) fn closed_one_sided(scene: &dyn Scene) -> Self {
+        let topo = scene.topology();
+        Self {
+            one_sided: topo
+                .components()
+                .iter()
+                .map(|c| c.closed && c.consistently_oriented)
+                .collect(),
+            explicit: vec![false; scene.triangle_count()],
+            explicit_list: Vec::new(),
+        }
+    }
+}
+
+fn overlap(a: &Aabb, b: &Aabb) -> bool {
+    !(a.max.cmplt(b.min).any() || b.max.cmplt(a.min).any())
+}
+
+/// Whether triangle `t` may meet the light of `shape` (bounds `light`): the boxes overlap and
+/// the triangle's plane passes through the light's hull (conservative: a triangle that does not
+/// is never reported).
+fn may_meet_light(t: [glam::Vec3; 3], shape: &LightShape, light: &Aabb) -> bool {
+    if !overlap(&Aabb::from_points(&t), light) {
+        return false;
+    }
+    let [a, b, c] = t.map(|v| v.as_dvec3());
+    let n = (b - a).cross(c - a);
+    let (mut below, mut above) = (false, false);
+    for p in shape.hull.iter().chain(std::iter::once(&shape.center)) {
+        let d = n.dot(p.as_dvec3() - a);
+        below |= d <= 0.0;
+        above |= d >= 0.0;
+    }
+    below && above
+}
+
+/// Every edge of the scene with its faces, weights and two-sidedness under `sides`.
+pub(crate) fn scene_edges(scene: &dyn Scene, sides: &Sides) -> (Vec<SceneEdge>, u32) {
+    let one_sided = &sides.one_sided;
     let topo = scene.topology();
     let positions = scene.positions();
     let tris = scene.triangles();
     let opac = scene.opacities();
     let semi = scene.has_semi_opaque();
     let units = if semi { OPACITY_UNITS } else { 1 };
-    let c = light_center.as_dvec3();
-    // Which closed, oriented components count from one side only: those that do not hold the
-    // light centre.
-    let closed: Vec<bool> = topo
-        .components()
-        .iter()
-        .map(|comp| comp.closed && comp.consistently_oriented)
-        .collect();
-    let around_centre = shadow_core::scene::components_containing(scene, c, &closed);
-    let one_sided: Vec<bool> = closed
-        .iter()
-        .zip(&around_centre)
-        .map(|(closed, around)| *closed && !*around)
-        .collect();
     let weight = |t: usize| -> u32 {
-        if semi {
+        if sides.explicit[t] {
+            0
+        } else if semi {
             (opac[t].clamp(0.0, 1.0) * OPACITY_UNITS as f32).ceil() as u32
         } else {
             1
@@ -237,6 +335,7 @@ pub(crate) fn silhouettes(edges: &[SceneEdge], light: &LightShape, mode: Silhoue
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec3;
     use shadow_core::light::{Radiance, RectLight};
     use shadow_core::prelude::*;
     use shadow_scenes::procedural;
@@ -272,7 +371,7 @@ mod tests {
             procedural::uv_sphere(Vec3::ZERO, 0.6, 10, 16),
         ] {
             let scene = scene_of(mesh);
-            let (edges, _) = scene_edges(&scene, shape.center);
+            let (edges, _) = scene_edges(&scene, &Sides::new(&scene, &shape));
             let accurate = silhouettes(&edges, &shape, Silhouettes::Accurate);
             let standard = silhouettes(&edges, &shape, Silhouettes::Standard);
             let c = shape.center.as_dvec3();

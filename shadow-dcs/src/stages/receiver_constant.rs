@@ -16,6 +16,7 @@ use shadow_core::geometry::ray_triangle_t;
 use shadow_core::scene::Scene;
 
 use crate::stages::constant::CrossingRule;
+use crate::stages::edges::Sides;
 
 /// The most cells along one axis.
 const MAX_CELLS_PER_AXIS: usize = 128;
@@ -38,8 +39,8 @@ pub(crate) struct CrossingGrid {
 impl CrossingGrid {
     /// The grid of `scene`'s triangles whose crossing toward the light centre `c` weighs
     /// anything.
-    pub(crate) fn new(scene: &dyn Scene, units: u32, c: Vec3) -> Self {
-        let rule = CrossingRule::new(scene, units, c.as_dvec3());
+    pub(crate) fn new(scene: &dyn Scene, units: u32, sides: &Sides, c: Vec3) -> Self {
+        let rule = CrossingRule::new(scene, units, sides, c.as_dvec3());
         let triangles: Vec<([DVec3; 3], i64)> = (0..scene.triangle_count())
             .into_par_iter()
             .filter_map(|t| {
@@ -214,11 +215,12 @@ impl CrossingGrid {
 pub(crate) fn receiver_constants(
     scene: &dyn Scene,
     units: u32,
+    sides: &Sides,
     c: Vec3,
     origins: &[Vec3],
     active: &[bool],
 ) -> Vec<i64> {
-    let grid = CrossingGrid::new(scene, units, c);
+    let grid = CrossingGrid::new(scene, units, sides, c);
     let cd = c.as_dvec3();
     origins
         .par_iter()
@@ -231,7 +233,7 @@ pub(crate) fn receiver_constants(
 mod tests {
     use super::*;
     use crate::stages::constant::{eye_constant, integration_constants};
-    use crate::stages::edges::{Silhouettes, scene_edges, silhouettes};
+    use crate::stages::edges::{Sides, Silhouettes, scene_edges, silhouettes};
     use crate::stages::light_shape::LightShape;
     use shadow_core::offset::RayOffset;
     use shadow_core::prelude::*;
@@ -247,7 +249,8 @@ mod tests {
             let light = setup.lights[0].as_ref();
             let view = ViewSamples::render(scene, &setup.camera_or_default(), 48, 36).unwrap();
             let shape = LightShape::new(light, "test").unwrap();
-            let (edges, units) = scene_edges(scene, shape.center);
+            let one_sided = Sides::new(scene, &shape);
+            let (edges, units) = scene_edges(scene, &one_sided);
             let sil = silhouettes(&edges, &shape, Silhouettes::Accurate);
             let offset = RayOffset::for_light(light);
             let origins: Vec<Vec3> = (0..view.len())
@@ -258,15 +261,15 @@ mod tests {
                 })
                 .collect();
             let valid = view.valid_mask();
-            let got = receiver_constants(scene, units, shape.center, &origins, &valid);
+            let got = receiver_constants(scene, units, &one_sided, shape.center, &origins, &valid);
             let c = shape.center.as_dvec3();
-            let rule = CrossingRule::new(scene, units, c);
+            let rule = CrossingRule::new(scene, units, &one_sided, c);
             let (eye, camera) = view.perspective().unwrap();
             let centred: Vec<Vec3> = origins
                 .iter()
                 .map(|o| (o.as_dvec3() - c).as_vec3())
                 .collect();
-            let eye_c = eye_constant(scene, units, eye, shape.center);
+            let eye_c = eye_constant(scene, units, &one_sided, eye, shape.center);
             let (volumes, _) = integration_constants(
                 &edges,
                 &sil,
@@ -322,7 +325,8 @@ mod tests {
         }
         let scene = b.build().unwrap();
         let c = Vec3::new(0.1, 4.0, 0.2);
-        let grid = CrossingGrid::new(&scene, 1, c);
+        let one_sided = Sides::closed_one_sided(&scene);
+        let grid = CrossingGrid::new(&scene, 1, &one_sided, c);
         for p in [
             Vec3::new(0.3, 0.0, -0.2),
             Vec3::new(0.3, -5.0, -0.2),

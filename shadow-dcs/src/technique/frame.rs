@@ -86,7 +86,7 @@ impl Dcs {
         let constants = match camera {
             Some((eye, camera)) => {
                 let (constants, quads) = stats.time(DcsPhase::ShadowVolumes, || {
-                    let eye_c = eye_constant(p.scene.as_ref(), p.units, eye, c);
+                    let eye_c = eye_constant(p.scene.as_ref(), p.units, &p.sides, eye, c);
                     integration_constants(
                         &p.edges,
                         &p.silhouettes,
@@ -104,7 +104,7 @@ impl Dcs {
             }
             None => {
                 let constants = stats.time(DcsPhase::ReceiverConstants, || {
-                    receiver_constants(p.scene.as_ref(), p.units, c, origins, &f.active)
+                    receiver_constants(p.scene.as_ref(), p.units, &p.sides, c, origins, &f.active)
                 });
                 let counted = f.active.iter().filter(|a| **a).count();
                 stats.add(DcsCounter::ReceiverConstantSegments, counted as u64);
@@ -311,14 +311,18 @@ impl Dcs {
             .require(&self.name, scene.as_ref(), light.as_ref())?;
         let mut stats = Stats::default();
         let shape = LightShape::new(light.as_ref(), &self.name)?;
-        let (edges, units) = stats.time(DcsPhase::Edges, || {
-            scene_edges(scene.as_ref(), shape.center)
-        });
+        let one_sided = Sides::new(scene.as_ref(), &shape);
+        let (edges, units) =
+            stats.time(DcsPhase::Edges, || scene_edges(scene.as_ref(), &one_sided));
         let sil = stats.time(DcsPhase::Silhouettes, || {
             silhouettes(&edges, &shape, self.detection)
         });
         stats.add(DcsCounter::Edges, edges.len() as u64);
         stats.add(DcsCounter::SilhouetteEdges, sil.len() as u64);
+        stats.add(
+            DcsCounter::ExplicitTriangles,
+            one_sided.explicit_list.len() as u64,
+        );
         let tables = match self.covered {
             CoveredSamples::Discrete | CoveredSamples::Refined => {
                 Some(stats.time(DcsPhase::DiscreteTables, || {
@@ -383,6 +387,7 @@ impl Dcs {
             edges,
             silhouettes: sil,
             units,
+            sides: one_sided,
             offset,
             extent: extent as f64,
             tables,

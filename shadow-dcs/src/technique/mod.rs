@@ -62,7 +62,7 @@ use crate::stages::constant::{eye_constant, integration_constants};
 use crate::stages::counters::{self, BitSliced, Packed, WIDTHS, width_for};
 use crate::stages::coverage::{EdgeTest, RelativePolygon, RelativeSamples};
 use crate::stages::discrete::{CoveredSamples, DiscreteTables, LineMasks};
-use crate::stages::edges::{SceneEdge, Silhouettes, scene_edges, silhouettes};
+use crate::stages::edges::{SceneEdge, Sides, Silhouettes, scene_edges, silhouettes};
 use crate::stages::light_shape::LightShape;
 use crate::stages::receiver_constant::receiver_constants;
 use crate::stages::wedges::{FOLD_SLACK, Pair};
@@ -95,6 +95,9 @@ struct Prepared {
     edges: Vec<SceneEdge>,
     silhouettes: Vec<u32>,
     units: u32,
+    /// How this light's depth complexities count the faces, and the triangles tested against
+    /// each sample explicitly ([`Sides`]).
+    sides: Sides,
     offset: RayOffset,
     extent: f64,
     tables: Option<DiscreteTables>,
@@ -340,6 +343,11 @@ struct Scratch {
     vis: Vec<f32>,
     /// The shadow rays' buffers, for traced pixels (made on the first one).
     rays: Option<RayScratch>,
+    /// The explicit triangles' buffers ([`Sides::explicit_list`]): the pixel's unit samples,
+    /// light samples and one mask per triangle.
+    explicit_units: Vec<Vec2>,
+    explicit_samples: Vec<LightSample>,
+    explicit_masks: Vec<u64>,
 }
 
 impl Scratch {

@@ -4,6 +4,10 @@
 //! (sections 4.3 and 4.4).
 
 use super::*;
+use shadow_core::geometry::ray_hits_triangle;
+
+/// Where a sample's segment ends, as a fraction of the way to the sample (the reference's).
+const SEGMENT_END: f64 = 1.0 - 1e-6;
 
 /// One view sample's pass (Algorithm 1 for one pixel): what each of its steps reads (the
 /// technique, its preparation, the frame, the pixel) and writes (the scratch, the counts).
@@ -98,7 +102,62 @@ impl PixelPass<'_, '_> {
         if !self.scratch.batch.is_empty() {
             Dcs::indexed_updates(self.scratch, self.counts, refined.as_ref());
         }
+        if !p.sides.explicit_list.is_empty() {
+            self.explicit_updates(&mut start);
+        }
         self.finish(&start)
+    }
+
+    /// The crossings of the pixel's sample segments with the triangles the light may pass
+    /// through ([`crate::stages::edges::Sides`]), tested one by one and added as updates: the
+    /// part of the depth complexity no wedge carries.
+    fn explicit_updates(&mut self, start: &mut PixelStart) {
+        let Self {
+            dcs, p, f, i, s, ..
+        } = *self;
+        let n = dcs.sampler.count() as usize;
+        let words = n.div_ceil(64);
+        let o = f.origins[i].as_dvec3();
+        let scratch = &mut *self.scratch;
+        dcs.sampler
+            .unit_samples(s.pixel, &mut scratch.explicit_units);
+        scratch.explicit_samples.clear();
+        p.light
+            .sample_into(&scratch.explicit_units, &mut scratch.explicit_samples);
+        let list = &p.sides.explicit_list;
+        scratch.explicit_masks.clear();
+        scratch.explicit_masks.resize(list.len() * words, 0);
+        let mut any = false;
+        for (&t, mask) in list.iter().zip(scratch.explicit_masks.chunks_mut(words)) {
+            let [a, b, c] = p.scene.triangle(t as usize).map(|v| v.as_dvec3());
+            for (k, y) in scratch.explicit_samples.iter().enumerate() {
+                // The reference's segment: it stops short of the light sample by a relative
+                // `1e-6`, so a face the sample lies on does not hide it.
+                if ray_hits_triangle(o, y.position.as_dvec3() - o, a, b, c, SEGMENT_END) {
+                    mask[k / 64] |= 1 << (k % 64);
+                    any = true;
+                }
+            }
+        }
+        if !any {
+            return;
+        }
+        self.ensure_ready(start);
+        let scratch = &mut *self.scratch;
+        let semi = p.scene.has_semi_opaque();
+        for (&t, mask) in list.iter().zip(scratch.explicit_masks.chunks(words)) {
+            if mask.iter().all(|&m| m == 0) {
+                continue;
+            }
+            let k = if semi {
+                (p.scene.opacities()[t as usize].clamp(0.0, 1.0) * p.units as f32).ceil() as i64
+            } else {
+                1
+            };
+            scratch
+                .updates
+                .push(mask, k, &mut self.counts.covered_updates);
+        }
     }
 
     /// The start of pixel `i`'s pass: its scratch emptied, its class when it faces away from the

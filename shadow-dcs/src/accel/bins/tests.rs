@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::accel::centred_wedges::wedges;
-use crate::stages::edges::{Silhouettes, scene_edges, silhouettes};
+use crate::stages::edges::{Sides, Silhouettes, scene_edges, silhouettes};
 use crate::stages::light_shape::LightShape;
 use crate::stages::wedges::FOLD_SLACK;
 use shadow_core::offset::RayOffset;
@@ -19,7 +19,7 @@ fn box_tests_agree_unrolled_and_not() {
     let view = ViewSamples::render(scene, &setup.camera_or_default(), w, h).unwrap();
     let light = setup.lights[0].as_ref();
     let shape = LightShape::new(light, "test").unwrap();
-    let (edges, _) = scene_edges(scene, shape.center);
+    let (edges, _) = scene_edges(scene, &Sides::new(scene, &shape));
     let sil = silhouettes(&edges, &shape, Silhouettes::Accurate);
     let scan: Vec<ScanWedge> = wedges(&edges, &sil, &shape)
         .iter()
@@ -213,7 +213,7 @@ fn the_hierarchy_finds_every_pair_of_the_brute_force_scan() {
         let view = ViewSamples::render(scene, &setup.camera_or_default(), w, h).unwrap();
         let light = setup.lights[0].as_ref();
         let shape = LightShape::new(light, "test").unwrap();
-        let (edges, _) = scene_edges(scene, shape.center);
+        let (edges, _) = scene_edges(scene, &Sides::new(scene, &shape));
         let sil = silhouettes(&edges, &shape, Silhouettes::Accurate);
         let ws = wedges(&edges, &sil, &shape);
         let (scan, lanes): (Vec<ScanWedge>, Vec<WedgeLanes>) =
