@@ -72,6 +72,18 @@ pub fn resolve_technique(
     samples: Option<u32>,
     seed: u64,
 ) -> Result<Box<dyn ShadowTechnique>, String> {
+    // A preset with a fixed count, asked for another: name the command line's way round it.
+    if let (Some(n), Ok(p)) = (samples, shadow_presets::preset(name))
+        && p.with_samples.is_none()
+    {
+        let family = shadow_presets::family_of(p.name);
+        if shadow_presets::resolve(family, Some(n), seed).is_ok() {
+            return Err(format!(
+                "technique `{name}` has a fixed sample count; use its family: `--technique \
+                 {family} --samples {n}`"
+            ));
+        }
+    }
     shadow_presets::resolve(name, samples, seed).map_err(|e| match e {
         TechniqueError::InvalidInput(m) => m,
         e => e.to_string(),

@@ -8,7 +8,7 @@
 //! mesh that contains the light centre is treated as two-sided as well (a segment may enter it
 //! without leaving), and so is one whose bounds overlap the light's: a light sample inside it,
 //! or a light partly set into it, is reached by a segment that enters the mesh and never
-//! leaves, which the one-sided count would miss ([`Sides`]); a face the light passes through
+//! leaves, which the one-sided count would miss (`Sides`); a face the light passes through
 //! is tested against each sample's segment instead. Weights are 1 for opaque scenes; with semi-opaque occluders each face
 //! weighs its opacity in units of `1/OPACITY_UNITS` (the paper's discretised opaqueness, section
 //! 4.4).
